@@ -1,0 +1,34 @@
+#pragma once
+//! @file box.hpp
+//! Oriented collision boxes (thesis section 3.1) and the point-in-box test.
+
+#include <mujoco/mujoco.h>
+
+#include <Eigen/Core>
+
+namespace leeway {
+
+//! An oriented box in world coordinates: centre, rotation (columns = box axes), half-sizes [m].
+struct Box {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d half_size = Eigen::Vector3d::Zero();
+};
+
+//! True when point p lies inside the box or on its surface (section 3.1: transform the point into
+//! the box frame and compare each coordinate with the half-size).
+bool contains(const Box& box, const Eigen::Vector3d& p);
+
+//! Separating-axis test of two oriented boxes (Gottschalk et al., the test cited in section 3.1)
+//! over the 15 candidate axes. Returns the penetration depth [m] (> 0: the boxes overlap by that
+//! much along the best axis, which for boxes is the exact minimum translation), 0 when they just
+//! touch, and a negative value when they are separated (minus the gap along the best axis, a
+//! lower bound of the true distance).
+double box_penetration(const Box& a, const Box& b);
+
+//! World-frame box of a geom after kinematics: exact for boxes; for other types the box bounds the
+//! geom in its own frame (sphere, capsule, cylinder, ellipsoid), or is the cube of its bounding
+//! sphere (mesh, height field). Planes have no finite box: the returned half-size is infinite.
+Box geom_box(const mjModel& m, const mjData& d, int geom);
+
+}  // namespace leeway

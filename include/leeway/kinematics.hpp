@@ -1,0 +1,89 @@
+#pragma once
+//! @file kinematics.hpp
+//! Forward kinematics, collision queries and inverse kinematics on a Scene. Each object owns one
+//! mjData: use one per thread with a shared const Scene.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "leeway/scene.hpp"
+
+namespace leeway {
+
+//! A position [m] and rotation (columns = frame axes in world) of a frame.
+struct Pose {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+};
+
+//! One robot-link-versus-obstacle contact.
+struct Contact {
+  int link_geom = -1;
+  int obstacle_geom = -1;
+  //! Penetration depth [m] (>= 0): exact for box pairs (separating-axis test), MuJoCo's contact
+  //! distance otherwise.
+  double depth = 0.0;
+};
+
+//! Forward kinematics and collision queries for one thread.
+class RobotState {
+ public:
+  explicit RobotState(const Scene& scene);
+
+  //! Sets the robot joints and runs MuJoCo's kinematics. @throws InputError on a bad size or NaN.
+  void set(const Eigen::VectorXd& q);
+  //! Pose of the tool site at the configuration last passed to set().
+  Pose tool_pose() const;
+  //! Pose of any site at the configuration last passed to set().
+  Pose site_pose(int site) const;
+  //! Tool pose at q.
+  Pose fk(const Eigen::VectorXd& q) {
+    set(q);
+    return tool_pose();
+  }
+  //! True when a robot link touches or penetrates an obstacle at q.
+  bool in_collision(const Eigen::VectorXd& q);
+  //! All robot-link-versus-obstacle contacts at q (deepest first).
+  std::vector<Contact> contacts(const Eigen::VectorXd& q);
+  //! 6 x dof Jacobian of the tool site (rows: linear, then angular) at the last set() q.
+  Eigen::MatrixXd tool_jacobian();
+
+  const Scene& scene() const { return *scene_; }
+  const mjData& data() const { return *data_; }
+
+ private:
+  void run_collision();
+  const Scene* scene_;
+  DataPtr data_;
+};
+
+//! Options of the numerical inverse kinematics.
+struct IkOptions {
+  bool tool_down = true;        //!< also require the tool z-axis along world -z (every thesis pose)
+  std::vector<bool> locked;     //!< joints kept at the seed value (empty: none)
+  int restarts = 24;            //!< random restarts after the seed itself
+  std::uint64_t seed = 1;       //!< RNG seed of the restarts
+  double position_tolerance = 1e-5;     //!< [m]
+  double orientation_tolerance = 1e-5;  //!< |z_tool - (-e_z)|, dimensionless
+  int max_iterations = 400;     //!< per start
+  bool require_collision_free = true;  //!< reject solutions in collision with the obstacles
+};
+
+//! Result of inverse kinematics.
+struct IkResult {
+  bool success = false;
+  Eigen::VectorXd q;               //!< best configuration found (the solution when success)
+  double position_error = 0.0;     //!< [m]
+  double orientation_error = 0.0;  //!< |z_tool - (-e_z)| (0 when tool_down is off)
+  int solutions_found = 0;         //!< distinct converged starts
+};
+
+//! Damped-least-squares inverse kinematics for the tool site within the joint limits, restarted
+//! from the seed and from seeded random configurations; returns the converged solution nearest the
+//! seed (joint-space distance). Deterministic for a given options.seed.
+//! @throws InputError when the target or seed is not finite or the seed has the wrong size.
+IkResult solve_ik(RobotState& state, const Eigen::Vector3d& target, const Eigen::VectorXd& seed,
+                  const IkOptions& options = {});
+
+}  // namespace leeway

@@ -1,0 +1,41 @@
+#pragma once
+//! @file mujoco_util.hpp
+//! Ownership of MuJoCo objects, and MuJoCo's error/warning callbacks turned into C++ behaviour.
+
+#include <mujoco/mujoco.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace leeway {
+
+//! Deletes an mjModel.
+struct ModelDeleter {
+  void operator()(mjModel* m) const { mj_deleteModel(m); }
+};
+//! Deletes an mjData.
+struct DataDeleter {
+  void operator()(mjData* d) const { mj_deleteData(d); }
+};
+using ModelPtr = std::unique_ptr<mjModel, ModelDeleter>;
+using DataPtr = std::unique_ptr<mjData, DataDeleter>;
+
+//! Installs process-wide MuJoCo handlers: mju_error throws InputError (no abort), warnings are
+//! collected per thread instead of being written to MUJOCO_LOG.TXT. Idempotent and thread-safe.
+void install_mujoco_handlers();
+
+//! Returns and clears the MuJoCo warnings raised on this thread since the last call.
+std::vector<std::string> take_mujoco_warnings();
+
+//! Compiles an MJCF (or MJB) file.
+//! @throws InputError naming the file when it is missing, unreadable or does not compile.
+ModelPtr load_model_file(const std::string& path);
+
+//! Allocates an mjData for a model. @throws std::bad_alloc when MuJoCo cannot allocate it.
+DataPtr make_data(const mjModel& model);
+
+//! Name of a MuJoCo object, or "" when it has none.
+std::string object_name(const mjModel& model, mjtObj type, int id);
+
+}  // namespace leeway

@@ -1,0 +1,113 @@
+#pragma once
+//! @file scene.hpp
+//! A workcell loaded from MJCF, with the robot, its links, the obstacles, goal sites and keyframes
+//! recognised by the rules of docs/mjcf-conventions.md.
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "leeway/mujoco_util.hpp"
+
+namespace leeway {
+
+//! One robot joint (1-dof hinge or slide), in the model's order.
+struct RobotJoint {
+  std::string name;
+  int id = -1;             //!< MuJoCo joint id
+  bool prismatic = false;  //!< slide joint [m] rather than hinge [rad]
+  double lower = 0.0;      //!< lower limit [rad or m]
+  double upper = 0.0;      //!< upper limit [rad or m]
+  double max_speed = 0.0;  //!< nominal max speed from joint user[0] [rad/s or m/s]; 0 if absent
+};
+
+//! What a geom is to leeway.
+enum class GeomRole {
+  kIgnored,    //!< not collidable in the file (contype = conaffinity = 0): visual only
+  kLink,       //!< collidable geom on a robot body that moves with a joint
+  kRobotBase,  //!< collidable geom on a robot body fixed to the world (base, rail): not checked
+  kObstacle,   //!< any other collidable geom
+};
+
+//! A named keyframe's joint values (robot joints in order).
+struct Keyframe {
+  std::string name;
+  Eigen::VectorXd q;
+};
+
+//! Options for recognising the scene.
+struct SceneOptions {
+  std::string tool_site = "tool0";  //!< the site at the robot's flange
+};
+
+//! A loaded, recognised workcell. Owns its mjModel, whose collision bitmasks are normalised so that
+//! MuJoCo reports only robot-link-versus-obstacle contacts (bit 0 of link contype against bit 0 of
+//! obstacle conaffinity).
+class Scene {
+ public:
+  //! Loads and recognises an MJCF file.
+  //! @throws InputError naming the file, element and value when the file cannot be used.
+  static Scene load(const std::string& path, const SceneOptions& options = {});
+
+  //! Recognises an already compiled model; `source` names it in messages.
+  //! @throws InputError as load().
+  static Scene from_model(ModelPtr model, std::string source, const SceneOptions& options = {});
+
+  const std::string& source() const { return source_; }
+  const mjModel& model() const { return *model_; }
+  int dof() const { return static_cast<int>(joints_.size()); }
+  const std::vector<RobotJoint>& joints() const { return joints_; }
+  std::vector<std::string> joint_names() const;
+  Eigen::VectorXd lower_limits() const;
+  Eigen::VectorXd upper_limits() const;
+  int robot_root_body() const { return robot_root_; }
+
+  const std::vector<int>& link_geoms() const { return link_geoms_; }
+  const std::vector<int>& base_geoms() const { return base_geoms_; }
+  const std::vector<int>& obstacle_geoms() const { return obstacle_geoms_; }
+  GeomRole role(int geom) const { return roles_.at(static_cast<size_t>(geom)); }
+  //! The geom's name, or "unnamed geom #id on body 'b'" when it has none.
+  std::string geom_label(int geom) const;
+
+  int tool_site() const { return tool_site_; }
+  const std::vector<int>& goal_sites() const { return goal_sites_; }
+  //! Site id of a goal site. @throws InputError listing the goal sites when unknown.
+  int goal_site(const std::string& name) const;
+
+  const std::vector<Keyframe>& keyframes() const { return keyframes_; }
+  //! A keyframe by name. @throws InputError listing the keyframes when unknown.
+  const Keyframe& keyframe(const std::string& name) const;
+
+  //! Checks a configuration's size and finiteness. @throws InputError naming `what`, the joint and
+  //! the value.
+  void validate_configuration(const Eigen::VectorXd& q, const std::string& what) const;
+
+  //! Indices of the joints whose value lies outside their limits.
+  std::vector<int> joints_outside_limits(const Eigen::VectorXd& q) const;
+
+  //! Copies a robot configuration into qpos (other entries untouched).
+  void set_qpos(mjData& d, const Eigen::VectorXd& q) const;
+
+ private:
+  Scene() = default;
+  void recognise(const SceneOptions& options);
+
+  std::string source_;
+  ModelPtr model_;
+  std::vector<RobotJoint> joints_;
+  int robot_root_ = -1;
+  std::vector<GeomRole> roles_;
+  std::vector<int> link_geoms_, base_geoms_, obstacle_geoms_;
+  int tool_site_ = -1;
+  std::vector<int> goal_sites_;
+  std::vector<Keyframe> keyframes_;
+};
+
+//! Parses "q1 q2 ..." (spaces or commas) into a vector. @throws InputError naming `what` and the
+//! offending token when a token is not a finite number.
+Eigen::VectorXd parse_vector(const std::string& text, const std::string& what);
+
+//! Formats a value compactly with up to 6 significant digits.
+std::string format_number(double v);
+
+}  // namespace leeway

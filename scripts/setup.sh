@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Installs, from Debian's packages, whatever leeway needs to build and test that is not there yet.
+# Idempotent and non-interactive; when everything is installed it only asks dpkg and returns.
+# libqhull-dev: Debian's mujoco::mujoco target names /usr/include/libqhull_r as an include path.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config
+  libmujoco-dev libqhull-dev libeigen3-dev libompl-dev libnlopt-cxx-dev liburdfdom-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#packages[@]} packages are installed"
+  exit 0
+fi
+
+sudo_cmd=()
+if [ "$(id -u)" -ne 0 ]; then
+  sudo_cmd=(sudo)
+fi
+echo "setup: installing ${missing[*]}"
+"${sudo_cmd[@]}" apt-get update -qq
+DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"

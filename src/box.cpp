@@ -1,0 +1,64 @@
+#include "leeway/box.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace leeway {
+
+bool contains(const Box& box, const Eigen::Vector3d& p) {
+  const Eigen::Vector3d local = box.rotation.transpose() * (p - box.center);
+  return (local.array().abs() <= box.half_size.array()).all();
+}
+
+double box_penetration(const Box& a, const Box& b) {
+  const Eigen::Vector3d d = b.center - a.center;
+  double best = INFINITY;  // smallest overlap over the axes tried
+  auto axis_overlap = [&](const Eigen::Vector3d& axis_in) {
+    const double n = axis_in.norm();
+    if (n < 1e-9) return;  // parallel edges: the face axes cover this case
+    const Eigen::Vector3d axis = axis_in / n;
+    const double ra = (a.rotation.transpose() * axis).cwiseAbs().dot(a.half_size);
+    const double rb = (b.rotation.transpose() * axis).cwiseAbs().dot(b.half_size);
+    best = std::min(best, ra + rb - std::abs(d.dot(axis)));
+  };
+  for (int i = 0; i < 3; ++i) axis_overlap(a.rotation.col(i));
+  for (int i = 0; i < 3; ++i) axis_overlap(b.rotation.col(i));
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) axis_overlap(a.rotation.col(i).cross(b.rotation.col(j)));
+  return best;
+}
+
+Box geom_box(const mjModel& m, const mjData& d, int geom) {
+  Box b;
+  b.center = Eigen::Map<const Eigen::Vector3d>(d.geom_xpos + 3 * geom);
+  // MuJoCo stores xmat row-major.
+  b.rotation = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(d.geom_xmat + 9 * geom);
+  const double* s = m.geom_size + 3 * geom;
+  switch (m.geom_type[geom]) {
+    case mjGEOM_BOX:
+    case mjGEOM_ELLIPSOID:
+      b.half_size = Eigen::Vector3d(s[0], s[1], s[2]);
+      break;
+    case mjGEOM_SPHERE:
+      b.half_size = Eigen::Vector3d::Constant(s[0]);
+      break;
+    case mjGEOM_CAPSULE:
+      b.half_size = Eigen::Vector3d(s[0], s[0], s[1] + s[0]);
+      break;
+    case mjGEOM_CYLINDER:
+      b.half_size = Eigen::Vector3d(s[0], s[0], s[1]);
+      break;
+    case mjGEOM_PLANE:
+      b.half_size = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+      break;
+    default:
+      b.half_size = Eigen::Vector3d::Constant(m.geom_rbound[geom]);
+      break;
+  }
+  return b;
+}
+
+}  // namespace leeway

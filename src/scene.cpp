@@ -1,0 +1,262 @@
+#include "leeway/scene.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+#include "leeway/error.hpp"
+
+namespace leeway {
+namespace {
+
+int top_ancestor(const mjModel& m, int body) {
+  while (body > 0 && m.body_parentid[body] != 0) body = m.body_parentid[body];
+  return body;
+}
+
+const char* joint_type_name(int type) {
+  switch (type) {
+    case mjJNT_FREE: return "free";
+    case mjJNT_BALL: return "ball";
+    case mjJNT_SLIDE: return "slide";
+    default: return "hinge";
+  }
+}
+
+std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& s : items) out += (out.empty() ? "" : ", ") + ("'" + s + "'");
+  return out.empty() ? "(none)" : out;
+}
+
+}  // namespace
+
+std::string format_number(double v) {
+  std::ostringstream os;
+  os.precision(6);
+  os << v;
+  return os.str();
+}
+
+Eigen::VectorXd parse_vector(const std::string& text, const std::string& what) {
+  std::vector<double> values;
+  std::string token;
+  std::istringstream in(text);
+  std::string chunk;
+  std::vector<std::string> tokens;
+  for (char c : text) {
+    if (c == ',' || std::isspace(static_cast<unsigned char>(c))) {
+      if (!token.empty()) tokens.push_back(token);
+      token.clear();
+    } else {
+      token += c;
+    }
+  }
+  if (!token.empty()) tokens.push_back(token);
+  for (size_t i = 0; i < tokens.size(); ++i) {
+    const std::string& t = tokens[i];
+    char* end = nullptr;
+    const double v = std::strtod(t.c_str(), &end);
+    if (end == t.c_str() || *end != '\0')
+      throw InputError(what + ": value " + std::to_string(i + 1) + " '" + t + "' is not a number");
+    if (!std::isfinite(v))
+      throw InputError(what + ": value " + std::to_string(i + 1) + " '" + t + "' is not finite");
+    values.push_back(v);
+  }
+  return Eigen::Map<Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
+}
+
+Scene Scene::load(const std::string& path, const SceneOptions& options) {
+  return from_model(load_model_file(path), path, options);
+}
+
+Scene Scene::from_model(ModelPtr model, std::string source, const SceneOptions& options) {
+  LEEWAY_DEMAND(model != nullptr);
+  Scene s;
+  s.model_ = std::move(model);
+  s.source_ = std::move(source);
+  s.recognise(options);
+  return s;
+}
+
+void Scene::recognise(const SceneOptions& options) {
+  mjModel& m = *model_;
+  const std::string& file = source_;
+
+  // Robot joints: every joint of the model, all in one top-level body subtree.
+  if (m.njnt == 0)
+    throw InputError(file + ": no robot joints: the model has no hinge or slide joint "
+                            "(see docs/mjcf-conventions.md)");
+  for (int j = 0; j < m.njnt; ++j) {
+    const std::string name = object_name(m, mjOBJ_JOINT, j);
+    const std::string label = name.empty() ? "#" + std::to_string(j) : "'" + name + "'";
+    if (m.jnt_type[j] != mjJNT_HINGE && m.jnt_type[j] != mjJNT_SLIDE)
+      throw InputError(file + ": joint " + label + " is a " + joint_type_name(m.jnt_type[j]) +
+                       " joint; robot joints must be hinge or slide");
+    if (name.empty())
+      throw InputError(file + ": joint #" + std::to_string(j) + " has no name; name every robot joint");
+    const int root = top_ancestor(m, m.jnt_bodyid[j]);
+    if (robot_root_ < 0) {
+      robot_root_ = root;
+    } else if (root != robot_root_) {
+      throw InputError(file + ": joint " + label + " is in body '" +
+                       object_name(m, mjOBJ_BODY, root) + "', outside the robot subtree '" +
+                       object_name(m, mjOBJ_BODY, robot_root_) +
+                       "'; leeway supports one robot (one top-level body with joints)");
+    }
+    if (!m.jnt_limited[j])
+      throw InputError(file + ": joint " + label + " has no range; robot joints need limits");
+    RobotJoint rj;
+    rj.name = name;
+    rj.id = j;
+    rj.prismatic = m.jnt_type[j] == mjJNT_SLIDE;
+    rj.lower = m.jnt_range[2 * j];
+    rj.upper = m.jnt_range[2 * j + 1];
+    if (!std::isfinite(rj.lower) || !std::isfinite(rj.upper) || rj.lower >= rj.upper)
+      throw InputError(file + ": joint " + label + " range '" + format_number(rj.lower) + " " +
+                       format_number(rj.upper) + "' is empty or not finite");
+    if (m.nuser_jnt > 0) {
+      rj.max_speed = m.jnt_user[j * m.nuser_jnt];
+      if (!std::isfinite(rj.max_speed) || rj.max_speed < 0)
+        throw InputError(file + ": joint " + label + " user[0] (max speed) '" +
+                         format_number(rj.max_speed) + "' must be a finite value >= 0");
+    }
+    joints_.push_back(rj);
+  }
+  LEEWAY_DEMAND(m.nq == m.njnt);
+
+  // Geoms: links, robot base, obstacles; bitmasks normalised for robot-versus-obstacle contacts.
+  roles_.assign(static_cast<size_t>(m.ngeom), GeomRole::kIgnored);
+  for (int g = 0; g < m.ngeom; ++g) {
+    const bool collidable = m.geom_contype[g] != 0 || m.geom_conaffinity[g] != 0;
+    const int body = m.geom_bodyid[g];
+    const bool robot = body != 0 && top_ancestor(m, body) == robot_root_;
+    GeomRole r = GeomRole::kIgnored;
+    if (collidable) {
+      if (robot)
+        r = m.body_weldid[body] != 0 ? GeomRole::kLink : GeomRole::kRobotBase;
+      else
+        r = GeomRole::kObstacle;
+    }
+    roles_[static_cast<size_t>(g)] = r;
+    switch (r) {
+      case GeomRole::kLink:
+        link_geoms_.push_back(g);
+        m.geom_contype[g] = 1;
+        m.geom_conaffinity[g] = 0;
+        break;
+      case GeomRole::kObstacle:
+        obstacle_geoms_.push_back(g);
+        m.geom_contype[g] = 0;
+        m.geom_conaffinity[g] = 1;
+        break;
+      case GeomRole::kRobotBase:
+        base_geoms_.push_back(g);
+        [[fallthrough]];
+      case GeomRole::kIgnored:
+        m.geom_contype[g] = 0;
+        m.geom_conaffinity[g] = 0;
+        break;
+    }
+  }
+  if (link_geoms_.empty())
+    throw InputError(file + ": the robot has no collidable geoms on its moving bodies "
+                            "(contype or conaffinity must be non-zero)");
+
+  // Sites: the tool site in the robot, goal sites outside it.
+  tool_site_ = mj_name2id(&m, mjOBJ_SITE, options.tool_site.c_str());
+  if (tool_site_ < 0)
+    throw InputError(file + ": no site named '" + options.tool_site +
+                     "' (the robot's tool site; choose another with --tool)");
+  const int tool_body = m.site_bodyid[tool_site_];
+  if (tool_body == 0 || top_ancestor(m, tool_body) != robot_root_ || m.body_weldid[tool_body] == 0)
+    throw InputError(file + ": tool site '" + options.tool_site +
+                     "' is not on a moving body of the robot");
+  for (int i = 0; i < m.nsite; ++i) {
+    const int b = m.site_bodyid[i];
+    if (b == 0 || top_ancestor(m, b) != robot_root_) goal_sites_.push_back(i);
+  }
+
+  // Keyframes.
+  for (int k = 0; k < m.nkey; ++k) {
+    Keyframe kf;
+    kf.name = object_name(m, mjOBJ_KEY, k);
+    if (kf.name.empty()) kf.name = "#" + std::to_string(k);
+    kf.q = Eigen::Map<const Eigen::VectorXd>(m.key_qpos + k * m.nq, m.nq);
+    for (int i = 0; i < m.nq; ++i)
+      if (!std::isfinite(kf.q[i]))
+        throw InputError(file + ": keyframe '" + kf.name + "' qpos value " + std::to_string(i + 1) +
+                         " (joint '" + joints_[static_cast<size_t>(i)].name + "') is '" +
+                         format_number(kf.q[i]) + "', not a finite number");
+    keyframes_.push_back(std::move(kf));
+  }
+}
+
+std::vector<std::string> Scene::joint_names() const {
+  std::vector<std::string> out;
+  for (const auto& j : joints_) out.push_back(j.name);
+  return out;
+}
+
+Eigen::VectorXd Scene::lower_limits() const {
+  Eigen::VectorXd v(dof());
+  for (int i = 0; i < dof(); ++i) v[i] = joints_[static_cast<size_t>(i)].lower;
+  return v;
+}
+
+Eigen::VectorXd Scene::upper_limits() const {
+  Eigen::VectorXd v(dof());
+  for (int i = 0; i < dof(); ++i) v[i] = joints_[static_cast<size_t>(i)].upper;
+  return v;
+}
+
+std::string Scene::geom_label(int geom) const {
+  const std::string n = object_name(*model_, mjOBJ_GEOM, geom);
+  if (!n.empty()) return n;
+  const std::string body = object_name(*model_, mjOBJ_BODY, model_->geom_bodyid[geom]);
+  return "unnamed geom #" + std::to_string(geom) + " on body '" + (body.empty() ? "world" : body) + "'";
+}
+
+int Scene::goal_site(const std::string& name) const {
+  std::vector<std::string> names;
+  for (int s : goal_sites_) {
+    const std::string n = object_name(*model_, mjOBJ_SITE, s);
+    if (n == name) return s;
+    names.push_back(n);
+  }
+  throw InputError(source_ + ": no goal site '" + name + "'; goal sites: " + join(names));
+}
+
+const Keyframe& Scene::keyframe(const std::string& name) const {
+  std::vector<std::string> names;
+  for (const auto& k : keyframes_) {
+    if (k.name == name) return k;
+    names.push_back(k.name);
+  }
+  throw InputError(source_ + ": no keyframe '" + name + "'; keyframes: " + join(names));
+}
+
+void Scene::validate_configuration(const Eigen::VectorXd& q, const std::string& what) const {
+  if (q.size() != dof())
+    throw InputError(what + ": " + std::to_string(q.size()) + " values given, the robot in " +
+                     source_ + " has " + std::to_string(dof()) + " joints");
+  for (int i = 0; i < dof(); ++i)
+    if (!std::isfinite(q[i]))
+      throw InputError(what + ": joint '" + joints_[static_cast<size_t>(i)].name + "' value '" +
+                       format_number(q[i]) + "' is not finite");
+}
+
+std::vector<int> Scene::joints_outside_limits(const Eigen::VectorXd& q) const {
+  std::vector<int> out;
+  for (int i = 0; i < dof(); ++i) {
+    const auto& j = joints_[static_cast<size_t>(i)];
+    if (q[i] < j.lower || q[i] > j.upper) out.push_back(i);
+  }
+  return out;
+}
+
+void Scene::set_qpos(mjData& d, const Eigen::VectorXd& q) const {
+  for (int i = 0; i < dof(); ++i) d.qpos[model_->jnt_qposadr[joints_[static_cast<size_t>(i)].id]] = q[i];
+}
+
+}  // namespace leeway

@@ -1,0 +1,126 @@
+#include "leeway/check.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "test_util.hpp"
+
+namespace leeway {
+namespace {
+
+using ::testing::HasSubstr;
+using test::one_link_cell;
+using test::workcell;
+
+class CheckTest : public test::MujocoTest {
+ protected:
+  test::TempDir dir_;
+  CheckReport run(const std::string& world, const std::string& keys = "") {
+    scene_ = std::make_unique<Scene>(Scene::load(dir_.write("cell.xml", one_link_cell(world, keys))));
+    return check_scene(*scene_);
+  }
+  bool has_problem(const CheckReport& r, const std::string& fragment) {
+    for (const auto& p : r.problems)
+      if (p.find(fragment) != std::string::npos) return true;
+    return false;
+  }
+  std::unique_ptr<Scene> scene_;
+};
+
+TEST_F(CheckTest, CleanCellPasses) {
+  // The tip moves on the circle of radius 1 m at z = 0.5 m; the goal (0, 1, 0.5) lies on it, 0.1 m
+  // above a table whose top is at 0.4 m.
+  const auto r = run(R"(<geom name="table" type="box" size="0.2 0.2 0.2" pos="0 1 0.2"/>
+    <site name="goal" pos="0 1 0.5"/>)",
+                     R"(<key name="home" qpos="0"/>)");
+  EXPECT_TRUE(r.ok()) << ::testing::PrintToString(r.problems);
+  ASSERT_EQ(r.goals.size(), 1u);
+  EXPECT_EQ(scene_->geom_label(r.goals[0].goal_obstacle), "table");
+  EXPECT_TRUE(r.goals[0].reachable);
+}
+
+TEST_F(CheckTest, KnownCollisionInAKeyframe) {
+  const auto r = run(R"(<geom name="wall" type="box" size="1 0.05 1" pos="0 1 1"/>)",
+                     R"(<key name="home" qpos="0"/><key name="left" qpos="1.5707963"/>)");
+  EXPECT_FALSE(r.ok());
+  ASSERT_EQ(r.keyframes.size(), 2u);
+  EXPECT_TRUE(r.keyframes[0].collisions.empty());
+  ASSERT_EQ(r.keyframes[1].collisions.size(), 1u);
+  EXPECT_NEAR(r.keyframes[1].collisions[0].depth, 0.05, 1e-6);
+  EXPECT_TRUE(has_problem(r, "keyframe 'left': link 'link_box' collides with obstacle 'wall'"));
+}
+
+TEST_F(CheckTest, JointLimitViolation) {
+  const auto r = run("", R"(<key name="over" qpos="3.1"/>)");
+  ASSERT_EQ(r.keyframes[0].limit_violations.size(), 1u);
+  EXPECT_TRUE(has_problem(r, "keyframe 'over': joint 'j1' = 3.1 rad is outside its range -3 .. 3 rad"));
+}
+
+TEST_F(CheckTest, GoalWithNoObstacleBelow) {
+  const auto r = run(R"(<geom name="table" type="box" size="0.2 0.2 0.2" pos="0 -1 0.2"/>
+    <site name="goal" pos="0 1 0.5"/>)");
+  ASSERT_EQ(r.goals.size(), 1u);
+  EXPECT_EQ(r.goals[0].goal_obstacle, -1);
+  EXPECT_TRUE(r.goals[0].reachable);
+  EXPECT_TRUE(has_problem(r, "goal site 'goal' at (0, 1, 0.5) m: no obstacle lies below it"));
+}
+
+TEST_F(CheckTest, GoalFarOutsideReach) {
+  // The tip moves on a circle of radius 1 m at z = 0.5 m: a site at (4, 0, 0.5) is 3 m away.
+  const auto r = run(R"(<geom name="pad" type="box" size="0.2 0.2 0.2" pos="4 0 0.2"/>
+    <site name="far" pos="4 0 0.5"/>)");
+  ASSERT_EQ(r.goals.size(), 1u);
+  EXPECT_FALSE(r.goals[0].reachable);
+  EXPECT_NEAR(r.goals[0].reach_error, 3.0, 1e-6);
+  EXPECT_TRUE(has_problem(r, "goal site 'far' at (4, 0, 0.5) m is outside the robot's reach"));
+}
+
+TEST_F(CheckTest, OverlappingObstacles) {
+  // Two boxes overlapping by 0.1 m along x; a third resting on the first (touching only).
+  const auto r = run(R"(<geom name="a" type="box" size="0.5 0.5 0.5" pos="2 2 0.5"/>
+    <geom name="b" type="box" size="0.5 0.5 0.5" pos="2.9 2 0.5"/>
+    <geom name="c" type="box" size="0.2 0.2 0.2" pos="2 2 1.2"/>)");
+  ASSERT_EQ(r.overlaps.size(), 1u);
+  EXPECT_NEAR(r.overlaps[0].depth, 0.1, 1e-6);
+  EXPECT_TRUE(has_problem(r, "obstacles 'a' and 'b' overlap by 0.1 m"));
+}
+
+TEST_F(CheckTest, UnnamedObstacleAndNonBoxObstacle) {
+  const auto r = run(R"(<geom type="box" size="0.1 0.1 0.1" pos="3 3 0.1"/>
+    <geom name="ball" type="sphere" size="0.1" pos="-3 3 0.1"/>)");
+  EXPECT_TRUE(has_problem(r, "unnamed geom"));
+  bool warned = false;
+  for (const auto& w : r.warnings) warned |= w.find("obstacle ball is not a box") != std::string::npos;
+  EXPECT_TRUE(warned) << ::testing::PrintToString(r.warnings);
+}
+
+TEST_F(CheckTest, JsonHasTheDocumentedFields) {
+  const auto r = run(R"(<geom name="wall" type="box" size="1 0.05 1" pos="0 1 1"/><site name="goal" pos="0 1 2.5"/>)",
+                     R"(<key name="left" qpos="1.5707963"/>)");
+  const auto j = to_json(*scene_, r);
+  EXPECT_FALSE(j.at("ok").get<bool>());
+  EXPECT_FALSE(j.at("problems").empty());
+  EXPECT_EQ(j.at("keyframes")[0].at("name"), "left");
+  EXPECT_EQ(j.at("keyframes")[0].at("collisions")[0].at("obstacle"), "wall");
+  EXPECT_TRUE(j.at("keyframes")[0].at("limit_violations").empty());
+  EXPECT_EQ(j.at("goals")[0].at("site"), "goal");
+  EXPECT_EQ(j.at("goals")[0].at("goal_obstacle"), "wall");
+}
+
+TEST_F(CheckTest, BundledWorkcellsPass) {
+  for (const char* cell : {"dallara", "baltico", "dlr"}) {
+    const Scene scene = Scene::load(workcell(cell));
+    const CheckReport r = check_scene(scene);
+    EXPECT_TRUE(r.ok()) << cell << ": " << ::testing::PrintToString(r.problems);
+    // Every goal site lies above a table or mould and is reachable with the tool down.
+    EXPECT_EQ(r.goals.size(), 2u) << cell;
+    for (const auto& g : r.goals) {
+      EXPECT_GE(g.goal_obstacle, 0) << cell << " " << g.site;
+      EXPECT_TRUE(g.reachable_tool_down) << cell << " " << g.site;
+    }
+    for (const char* key : {"home", "patch", "mould"}) EXPECT_NO_THROW(scene.keyframe(key)) << cell;
+  }
+}
+
+}  // namespace
+}  // namespace leeway

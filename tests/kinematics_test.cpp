@@ -1,0 +1,146 @@
+#include "leeway/kinematics.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "leeway/error.hpp"
+#include "test_util.hpp"
+
+namespace leeway {
+namespace {
+
+using test::one_link_cell;
+using test::workcell;
+
+// The thesis's published joint values and gripper positions (chapter 4, sections 4.2.1-4.2.2).
+struct PublishedPose {
+  const char* cell;
+  const char* key;
+  double q[6];
+  double position_mm[3];
+};
+const PublishedPose kPublished[] = {
+    {"dallara", "patch", {-1.11219, 0.734922, 0.0866255, -3.14159, -0.749248, -1.11219}, {943, -1910, 800}},
+    {"dallara", "mould", {0.251572, 0.282489, -0.107214, -3.14159, -1.39552, 0.251572}, {1817, 467, 1800}},
+    {"baltico", "patch", {0.978215, 0.766918, 0.0255917, -3.14159, -0.778286, 0.978215}, {1218, 1809, 800}},
+    {"baltico", "mould", {2.59301, -0.629514, -2.18935, 1.00597e-16, -1.89352, -0.548579}, {1381, -844, 1800}},
+};
+
+Eigen::VectorXd published_q(const PublishedPose& p) { return Eigen::Map<const Eigen::VectorXd>(p.q, 6); }
+Eigen::Vector3d published_position(const PublishedPose& p) {
+  return Eigen::Vector3d(p.position_mm[0], p.position_mm[1], p.position_mm[2]) / 1000.0;
+}
+
+class KinematicsTest : public test::MujocoTest {};
+
+TEST_F(KinematicsTest, PublishedPairsWithinOneMillimetre) {
+  for (const auto& p : kPublished) {
+    const Scene scene = Scene::load(workcell(p.cell));
+    RobotState state(scene);
+    const Pose pose = state.fk(published_q(p));
+    const double err_mm = (pose.position - published_position(p)).norm() * 1000;
+    EXPECT_LT(err_mm, 1.0) << p.cell << " " << p.key;
+    // Every thesis pose has the tool pointing straight down.
+    EXPECT_NEAR(pose.rotation(2, 2), -1.0, 1e-5) << p.cell << " " << p.key;
+    // The cell's keyframe holds the published values.
+    EXPECT_LT((scene.keyframe(p.key).q - published_q(p)).cwiseAbs().maxCoeff(), 1e-9) << p.cell << " " << p.key;
+  }
+}
+
+TEST_F(KinematicsTest, HomePoseMatchesTheDatasheet) {
+  // All zeros: flange at (320 + 1182.5 + 200, 0, 780 + 1280 + 200) mm, tool z-axis along +x.
+  const Scene scene = Scene::load(workcell("dallara"));
+  RobotState state(scene);
+  const Pose pose = state.fk(Eigen::VectorXd::Zero(6));
+  EXPECT_NEAR(pose.position.x(), 1.7025, 1e-9);
+  EXPECT_NEAR(pose.position.y(), 0.0, 1e-9);
+  EXPECT_NEAR(pose.position.z(), 2.26, 1e-9);
+  EXPECT_NEAR(pose.rotation(0, 2), 1.0, 1e-4);
+}
+
+TEST_F(KinematicsTest, OneLinkArmAnalytic) {
+  test::TempDir dir;
+  const Scene scene = Scene::load(dir.write("cell.xml", one_link_cell("")));
+  RobotState state(scene);
+  Eigen::VectorXd q(1);
+  q << 0.5;
+  const Pose pose = state.fk(q);
+  EXPECT_NEAR(pose.position.x(), std::cos(0.5), 1e-12);
+  EXPECT_NEAR(pose.position.y(), std::sin(0.5), 1e-12);
+  EXPECT_NEAR(pose.position.z(), 0.5, 1e-12);
+}
+
+TEST_F(KinematicsTest, ContactDepthAgainstAWall) {
+  // At q = pi/2 the link spans y = 0 .. 1; a wall whose near face is at y = 0.95 is penetrated
+  // by 0.05 m. At q = 0 the link lies along x and is clear.
+  test::TempDir dir;
+  const Scene scene =
+      Scene::load(dir.write("cell.xml", one_link_cell(R"(<geom name="wall" type="box" size="1 0.05 1" pos="0 1 1"/>)")));
+  RobotState state(scene);
+  Eigen::VectorXd q(1);
+  q << M_PI / 2;
+  const auto contacts = state.contacts(q);
+  ASSERT_EQ(contacts.size(), 1u);
+  EXPECT_EQ(scene.geom_label(contacts[0].link_geom), "link_box");
+  EXPECT_EQ(scene.geom_label(contacts[0].obstacle_geom), "wall");
+  EXPECT_NEAR(contacts[0].depth, 0.05, 1e-6);
+  q << 0.0;
+  EXPECT_FALSE(state.in_collision(q));
+}
+
+TEST_F(KinematicsTest, IkRecoversThePublishedPosesOnTheirBranch) {
+  for (const auto& p : kPublished) {
+    const Scene scene = Scene::load(workcell(p.cell));
+    RobotState state(scene);
+    Eigen::VectorXd seed = published_q(p);
+    seed.head<3>().array() += 0.05;  // seeded near, not at, the published joints
+    const IkResult r = solve_ik(state, published_position(p), seed);
+    ASSERT_TRUE(r.success) << p.cell << " " << p.key;
+    EXPECT_LT((state.fk(r.q).position - published_position(p)).norm() * 1000, 1.0) << p.cell << " " << p.key;
+    // Same branch: the arm joints that fix the position come back to the published values.
+    EXPECT_LT((r.q.head<3>() - published_q(p).head<3>()).cwiseAbs().maxCoeff(), 2e-3) << p.cell << " " << p.key;
+    EXPECT_NEAR(state.fk(r.q).rotation(2, 2), -1.0, 1e-4);
+  }
+}
+
+TEST_F(KinematicsTest, IkOneLinkAnalyticAndUnreachable) {
+  test::TempDir dir;
+  const Scene scene = Scene::load(dir.write("cell.xml", one_link_cell("")));
+  RobotState state(scene);
+  IkOptions opt;
+  opt.tool_down = false;
+  const Eigen::VectorXd seed = Eigen::VectorXd::Zero(1);
+  IkResult r = solve_ik(state, {std::cos(1.0), std::sin(1.0), 0.5}, seed, opt);
+  ASSERT_TRUE(r.success);
+  EXPECT_NEAR(r.q[0], 1.0, 1e-5);
+  // A target 3 m out on the x-axis: the tip (1 m long link) gets no closer than 2 m.
+  r = solve_ik(state, {3.0, 0.0, 0.5}, seed, opt);
+  EXPECT_FALSE(r.success);
+  EXPECT_NEAR(r.position_error, 2.0, 1e-6);
+}
+
+TEST_F(KinematicsTest, IkIsDeterministicForASeed) {
+  const Scene scene = Scene::load(workcell("dallara"));
+  RobotState a(scene), b(scene);
+  const Eigen::Vector3d target(1.2, -0.8, 1.0);
+  IkOptions opt;
+  opt.seed = 7;
+  const IkResult ra = solve_ik(a, target, Eigen::VectorXd::Zero(6), opt);
+  const IkResult rb = solve_ik(b, target, Eigen::VectorXd::Zero(6), opt);
+  ASSERT_TRUE(ra.success);
+  EXPECT_EQ(ra.q, rb.q);
+}
+
+TEST_F(KinematicsTest, RejectsBadConfigurations) {
+  const Scene scene = Scene::load(workcell("dallara"));
+  RobotState state(scene);
+  EXPECT_THROW(state.fk(Eigen::VectorXd::Zero(5)), InputError);
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(6);
+  q[2] = INFINITY;
+  EXPECT_THROW(state.fk(q), InputError);
+  EXPECT_THROW(solve_ik(state, {std::nan(""), 0, 1}, Eigen::VectorXd::Zero(6)), InputError);
+}
+
+}  // namespace
+}  // namespace leeway

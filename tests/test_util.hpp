@@ -1,0 +1,101 @@
+#pragma once
+// Test support: MJCF strings written to temporary files, the CLI run as a subprocess, and a fixture
+// that turns any MuJoCo warning into a test failure.
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+
+#include "leeway/mujoco_util.hpp"
+
+namespace leeway::test {
+
+//! A temporary directory removed when the object dies.
+class TempDir {
+ public:
+  TempDir() {
+    std::string tmpl = (std::filesystem::temp_directory_path() / "leeway_test_XXXXXX").string();
+    path_ = ::mkdtemp(tmpl.data());
+  }
+  ~TempDir() { std::filesystem::remove_all(path_); }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  //! Writes `text` to `name` inside the directory and returns its path.
+  std::string write(const std::string& name, const std::string& text) const {
+    const auto p = path_ / name;
+    std::ofstream(p) << text;
+    return p.string();
+  }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+//! Output and exit code of a CLI invocation.
+struct CliResult {
+  int exit_code = -1;
+  std::string out;  // stdout and stderr together
+};
+
+//! Runs the leeway program with `args` (a shell-quoted string).
+inline CliResult run_cli(const std::string& args) {
+  const std::string cmd = std::string(LEEWAY_CLI) + " " + args + " 2>&1";
+  CliResult r;
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buf{};
+  size_t n = 0;
+  while ((n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0) r.out.append(buf.data(), n);
+  const int status = ::pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+//! Path of a bundled workcell.
+inline std::string workcell(const std::string& name) {
+  return std::string(LEEWAY_MJCF_DIR) + "/workcells/" + name + ".xml";
+}
+
+//! Fails the test on any MuJoCo warning raised on the test's thread.
+class MujocoTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    install_mujoco_handlers();
+    take_mujoco_warnings();
+  }
+  void TearDown() override {
+    for (const auto& w : take_mujoco_warnings()) ADD_FAILURE() << "MuJoCo warning: " << w;
+  }
+};
+
+//! A one-link arm: hinge j1 about z at (0, 0, 0.5), a 1 m box link along +x (half-size
+//! 0.5 x 0.05 x 0.05), tool0 at its tip. `world` is inserted into the world body.
+inline std::string one_link_cell(const std::string& world, const std::string& keys = "") {
+  return R"(<mujoco model="one-link">
+  <compiler angle="radian" autolimits="true"/>
+  <worldbody>
+    <geom name="floor" type="plane" size="5 5 0.1" contype="0" conaffinity="0"/>
+    <body name="base">
+      <geom name="base_box" type="box" size="0.1 0.1 0.25" pos="0 0 0.25"/>
+      <body name="link" pos="0 0 0.5">
+        <joint name="j1" type="hinge" axis="0 0 1" range="-3 3" user="1.5"/>
+        <geom name="link_box" type="box" size="0.5 0.05 0.05" pos="0.5 0 0"/>
+        <site name="tool0" pos="1 0 0"/>
+      </body>
+    </body>
+)" + world + R"(
+  </worldbody>
+  <keyframe>
+)" + keys + R"(
+  </keyframe>
+</mujoco>
+)";
+}
+
+}  // namespace leeway::test

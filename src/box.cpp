@@ -31,6 +31,34 @@ double box_penetration(const Box& a, const Box& b) {
   return best;
 }
 
+Eigen::Vector3d closest_point(const Box& box, const Eigen::Vector3d& p) {
+  const Eigen::Vector3d local = box.rotation.transpose() * (p - box.center);
+  const Eigen::Vector3d clamped = local.cwiseMax(-box.half_size).cwiseMin(box.half_size);
+  return box.center + box.rotation * clamped;
+}
+
+double box_distance(const Box& a, const Box& b, Eigen::Vector3d* on_a, Eigen::Vector3d* on_b) {
+  Eigen::Vector3d pa = closest_point(a, b.center);
+  Eigen::Vector3d pb = closest_point(b, pa);
+  if (box_penetration(a, b) >= 0) {
+    // Touching or overlapping: distance 0 (the points are approximate witnesses).
+    if (on_a) *on_a = pa;
+    if (on_b) *on_b = pb;
+    return 0.0;
+  }
+  for (int it = 0; it < 100000; ++it) {
+    const Eigen::Vector3d na = closest_point(a, pb);
+    const Eigen::Vector3d nb = closest_point(b, na);
+    const double moved = (na - pa).norm() + (nb - pb).norm();
+    pa = na;
+    pb = nb;
+    if (moved < 1e-12) break;
+  }
+  if (on_a) *on_a = pa;
+  if (on_b) *on_b = pb;
+  return (pa - pb).norm();
+}
+
 Box geom_box(const mjModel& m, const mjData& d, int geom) {
   Box b;
   b.center = Eigen::Map<const Eigen::Vector3d>(d.geom_xpos + 3 * geom);

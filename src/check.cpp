@@ -95,6 +95,7 @@ CheckReport check_scene(const Scene& scene, const CheckOptions& options) {
     f.q = k.q;
     f.collisions = state.contacts(k.q);
     f.tool = state.tool_pose();
+    f.clearance = state.clearance(k.q);
     f.limit_violations = scene.joints_outside_limits(k.q);
     for (const auto& c : f.collisions)
       report.problems.push_back("keyframe '" + k.name + "': link '" + scene.geom_label(c.link_geom) +
@@ -103,8 +104,8 @@ CheckReport check_scene(const Scene& scene, const CheckOptions& options) {
     for (int j : f.limit_violations) {
       const auto& joint = scene.joints()[static_cast<size_t>(j)];
       const char* unit = joint.prismatic ? " m" : " rad";
-      report.problems.push_back("keyframe '" + k.name + "': joint '" + joint.name + "' = " +
-                                format_number(k.q[j]) + unit + " is outside its range " +
+      report.problems.push_back("keyframe '" + k.name + "': joint '" + joint.name +
+                                "' = " + format_number(k.q[j]) + unit + " is outside its range " +
                                 format_number(joint.lower) + " .. " + format_number(joint.upper) + unit);
     }
     report.keyframes.push_back(std::move(f));
@@ -172,8 +173,11 @@ nlohmann::json to_json(const Scene& scene, const CheckReport& report) {
   out["warnings"] = report.warnings;
   json joints = json::array();
   for (const auto& j : scene.joints())
-    joints.push_back({{"name", j.name}, {"type", j.prismatic ? "slide" : "hinge"}, {"lower", j.lower},
-                      {"upper", j.upper}, {"max_speed", j.max_speed}});
+    joints.push_back({{"name", j.name},
+                      {"type", j.prismatic ? "slide" : "hinge"},
+                      {"lower", j.lower},
+                      {"upper", j.upper},
+                      {"max_speed", j.max_speed}});
   json links = json::array();
   for (int g : scene.link_geoms()) links.push_back(scene.geom_label(g));
   json base = json::array();
@@ -198,32 +202,45 @@ nlohmann::json to_json(const Scene& scene, const CheckReport& report) {
   for (const auto& k : report.keyframes) {
     json col = json::array();
     for (const auto& c : k.collisions)
-      col.push_back({{"link", scene.geom_label(c.link_geom)}, {"obstacle", scene.geom_label(c.obstacle_geom)},
+      col.push_back({{"link", scene.geom_label(c.link_geom)},
+                     {"obstacle", scene.geom_label(c.obstacle_geom)},
                      {"depth", c.depth}});
     json lim = json::array();
     for (int j : k.limit_violations) {
       const auto& joint = scene.joints()[static_cast<size_t>(j)];
-      lim.push_back({{"joint", joint.name}, {"value", k.q[j]}, {"lower", joint.lower}, {"upper", joint.upper}});
+      lim.push_back(
+          {{"joint", joint.name}, {"value", k.q[j]}, {"lower", joint.lower}, {"upper", joint.upper}});
     }
-    keys.push_back({{"name", k.name}, {"q", vec(k.q)}, {"tool_position", v3(k.tool.position)},
-                    {"collisions", col}, {"limit_violations", lim}});
+    json clear = nullptr;
+    if (k.clearance.link_geom >= 0)
+      clear = {{"distance", k.clearance.distance},
+               {"link", scene.geom_label(k.clearance.link_geom)},
+               {"obstacle", scene.geom_label(k.clearance.obstacle_geom)}};
+    keys.push_back({{"name", k.name},
+                    {"q", vec(k.q)},
+                    {"tool_position", v3(k.tool.position)},
+                    {"collisions", col},
+                    {"limit_violations", lim},
+                    {"clearance", clear}});
   }
   out["keyframes"] = keys;
   json goals = json::array();
   for (const auto& g : report.goals) {
-    json item = {{"site", g.site},
-                 {"position", v3(g.position)},
-                 {"goal_obstacle", g.goal_obstacle >= 0 ? json(scene.geom_label(g.goal_obstacle)) : json(nullptr)},
-                 {"reachable", g.reachable},
-                 {"reach_error", g.reach_error},
-                 {"reachable_tool_down", g.reachable_tool_down}};
+    json item = {
+        {"site", g.site},
+        {"position", v3(g.position)},
+        {"goal_obstacle", g.goal_obstacle >= 0 ? json(scene.geom_label(g.goal_obstacle)) : json(nullptr)},
+        {"reachable", g.reachable},
+        {"reach_error", g.reach_error},
+        {"reachable_tool_down", g.reachable_tool_down}};
     item["q_tool_down"] = g.reachable_tool_down ? vec(g.q_tool_down) : json(nullptr);
     goals.push_back(item);
   }
   out["goals"] = goals;
   json overlaps = json::array();
   for (const auto& o : report.overlaps)
-    overlaps.push_back({{"a", scene.geom_label(o.geom_a)}, {"b", scene.geom_label(o.geom_b)}, {"depth", o.depth}});
+    overlaps.push_back(
+        {{"a", scene.geom_label(o.geom_a)}, {"b", scene.geom_label(o.geom_b)}, {"depth", o.depth}});
   out["overlaps"] = overlaps;
   return out;
 }
@@ -242,10 +259,17 @@ std::string to_text(const Scene& scene, const CheckReport& report) {
   os << ")\n";
   for (const auto& k : report.keyframes) {
     os << "keyframe " << k.name << ": tool at " << vec3(k.tool.position) << " m, ";
-    if (k.collisions.empty() && k.limit_violations.empty())
-      os << "clear, within limits\n";
-    else
-      os << k.collisions.size() << " collision(s), " << k.limit_violations.size() << " joint(s) outside limits\n";
+    if (k.collisions.empty() && k.limit_violations.empty()) {
+      os << "within limits, ";
+      if (k.clearance.link_geom >= 0)
+        os << "clearance " << format_number(k.clearance.distance) << " m ("
+           << scene.geom_label(k.clearance.link_geom) << " to " << scene.geom_label(k.clearance.obstacle_geom)
+           << ")\n";
+      else
+        os << "no obstacles\n";
+    } else
+      os << k.collisions.size() << " collision(s), " << k.limit_violations.size()
+         << " joint(s) outside limits\n";
   }
   for (const auto& g : report.goals) {
     os << "goal site " << g.site << " at " << vec3(g.position) << " m: goal obstacle "

@@ -82,6 +82,21 @@ std::vector<Contact> RobotState::contacts(const Eigen::VectorXd& q) {
   return out;
 }
 
+Clearance RobotState::clearance(const Eigen::VectorXd& q) {
+  set(q);
+  const mjModel& m = scene_->model();
+  Clearance best;
+  for (int o : scene_->obstacle_geoms()) {
+    if (m.geom_type[o] == mjGEOM_PLANE) continue;
+    const Box ob = geom_box(m, *data_, o);
+    for (int l : scene_->link_geoms()) {
+      const double dist = box_distance(geom_box(m, *data_, l), ob);
+      if (dist < best.distance) best = {dist, l, o};
+    }
+  }
+  return best;
+}
+
 Eigen::MatrixXd RobotState::tool_jacobian() {
   const mjModel& m = scene_->model();
   mj_comPos(&m, data_.get());
@@ -137,10 +152,12 @@ IkResult solve_ik(RobotState& state, const Eigen::Vector3d& target, const Eigen:
       Eigen::MatrixXd jac = state.tool_jacobian();
       Eigen::MatrixXd j(r.size(), n);
       j.topRows<3>() = jac.topRows<3>();
-      if (options.tool_down) j.bottomRows<3>() = -skew(state.tool_pose().rotation.col(2)) * jac.bottomRows<3>();
+      if (options.tool_down)
+        j.bottomRows<3>() = -skew(state.tool_pose().rotation.col(2)) * jac.bottomRows<3>();
       for (int i = 0; i < n; ++i)
         if (locked[static_cast<size_t>(i)]) j.col(i).setZero();
-      const Eigen::MatrixXd a = j * j.transpose() + lambda * lambda * Eigen::MatrixXd::Identity(r.size(), r.size());
+      const Eigen::MatrixXd a =
+          j * j.transpose() + lambda * lambda * Eigen::MatrixXd::Identity(r.size(), r.size());
       Eigen::VectorXd dq = -j.transpose() * a.ldlt().solve(r);
       const double step = dq.cwiseAbs().maxCoeff();
       if (step > 0.3) dq *= 0.3 / step;

@@ -41,7 +41,8 @@ Eigen::VectorXd configuration(const leeway::Scene& scene, const std::string& q, 
                               const std::string& what) {
   if (!q.empty() && !key.empty()) throw InputError(what + ": give either --q or --key, not both");
   if (!key.empty()) return scene.keyframe(key).q;
-  if (q.empty()) throw InputError(what + ": give the joint values with --q \"q1 q2 ...\" or a keyframe with --key");
+  if (q.empty())
+    throw InputError(what + ": give the joint values with --q \"q1 q2 ...\" or a keyframe with --key");
   Eigen::VectorXd v = leeway::parse_vector(q, what + " --q");
   scene.validate_configuration(v, what + " --q");
   return v;
@@ -52,7 +53,8 @@ std::string joint_unit(const leeway::RobotJoint& j) { return j.prismatic ? "m" :
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"leeway: collision-free joint intervals around a nominal robot path (SI units: metres, radians)"};
+  CLI::App app{
+      "leeway: collision-free joint intervals around a nominal robot path (SI units: metres, radians)"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "leeway 0.1.0");
 
@@ -66,12 +68,14 @@ int main(int argc, char** argv) {
   bool check_json = false;
   leeway::CheckOptions check_opts;
   CLI::App* check = app.add_subcommand(
-      "check", "Check an MJCF cell: keyframe collisions and limits, goal obstacles, reach, overlaps.\n"
-               "Exit 0 clean, 1 problems found, 2 the file cannot be used.");
+      "check",
+      "Check an MJCF cell: keyframe collisions and limits, goal obstacles, reach, overlaps.\n"
+      "Exit 0 clean, 1 problems found, 2 the file cannot be used.");
   check->add_option("cell", check_file, "MJCF file of the workcell")->required();
   check->add_flag("--json", check_json, "Print one JSON object instead of text");
   check->add_option("--dz", check_opts.goal_dz, "Algorithm 1 descent step [m]")->capture_default_str();
-  check->add_option("--seed", check_opts.seed, "Seed of the inverse-kinematics restarts")->capture_default_str();
+  check->add_option("--seed", check_opts.seed, "Seed of the inverse-kinematics restarts")
+      ->capture_default_str();
   add_tool(check);
 
   // fk
@@ -90,8 +94,9 @@ int main(int argc, char** argv) {
   bool ik_json = false, ik_free = false;
   leeway::IkOptions ik_opts;
   CLI::App* ik = app.add_subcommand(
-      "ik", "Inverse kinematics: joint values that put the tool site at a goal, tool pointing down,\n"
-            "within limits and collision-free, nearest the seed. Exit 1 when no solution is found.");
+      "ik",
+      "Inverse kinematics: joint values that put the tool site at a goal, tool pointing down,\n"
+      "within limits and collision-free, nearest the seed. Exit 1 when no solution is found.");
   ik->add_option("cell", ik_file, "MJCF file of the workcell")->required();
   auto* site_opt = ik->add_option("--site", ik_site, "Goal site name");
   ik->add_option("--xyz", ik_xyz, "Goal position x y z [m]")->expected(3)->excludes(site_opt);
@@ -172,7 +177,8 @@ int main(int argc, char** argv) {
       else if (!scene.keyframes().empty())
         seed = scene.keyframes().front().q;
       else
-        seed = Eigen::VectorXd::Zero(scene.dof()).cwiseMax(scene.lower_limits()).cwiseMin(scene.upper_limits());
+        seed =
+            Eigen::VectorXd::Zero(scene.dof()).cwiseMax(scene.lower_limits()).cwiseMin(scene.upper_limits());
       ik_opts.tool_down = !ik_free;
       ik_opts.locked.assign(static_cast<size_t>(scene.dof()), false);
       if (!ik_lock.empty()) {
@@ -207,7 +213,8 @@ int main(int argc, char** argv) {
                     {"units", "SI: metres, radians"}};
         std::cout << out.dump(2) << "\n";
       } else {
-        std::cout << (result.success ? "solution" : "NO SOLUTION; closest configuration") << " (units: rad, m):\n";
+        std::cout << (result.success ? "solution" : "NO SOLUTION; closest configuration")
+                  << " (units: rad, m):\n";
         for (int i = 0; i < scene.dof(); ++i) {
           const auto& j = scene.joints()[static_cast<size_t>(i)];
           std::cout << "  " << j.name << " = " << result.q[i] << " " << joint_unit(j) << "\n";

@@ -16,10 +16,14 @@ int top_ancestor(const mjModel& m, int body) {
 
 const char* joint_type_name(int type) {
   switch (type) {
-    case mjJNT_FREE: return "free";
-    case mjJNT_BALL: return "ball";
-    case mjJNT_SLIDE: return "slide";
-    default: return "hinge";
+    case mjJNT_FREE:
+      return "free";
+    case mjJNT_BALL:
+      return "ball";
+    case mjJNT_SLIDE:
+      return "slide";
+    default:
+      return "hinge";
   }
 }
 
@@ -85,8 +89,9 @@ void Scene::recognise(const SceneOptions& options) {
 
   // Robot joints: every joint of the model, all in one top-level body subtree.
   if (m.njnt == 0)
-    throw InputError(file + ": no robot joints: the model has no hinge or slide joint "
-                            "(see docs/mjcf-conventions.md)");
+    throw InputError(file +
+                     ": no robot joints: the model has no hinge or slide joint "
+                     "(see docs/mjcf-conventions.md)");
   for (int j = 0; j < m.njnt; ++j) {
     const std::string name = object_name(m, mjOBJ_JOINT, j);
     const std::string label = name.empty() ? "#" + std::to_string(j) : "'" + name + "'";
@@ -99,9 +104,8 @@ void Scene::recognise(const SceneOptions& options) {
     if (robot_root_ < 0) {
       robot_root_ = root;
     } else if (root != robot_root_) {
-      throw InputError(file + ": joint " + label + " is in body '" +
-                       object_name(m, mjOBJ_BODY, root) + "', outside the robot subtree '" +
-                       object_name(m, mjOBJ_BODY, robot_root_) +
+      throw InputError(file + ": joint " + label + " is in body '" + object_name(m, mjOBJ_BODY, root) +
+                       "', outside the robot subtree '" + object_name(m, mjOBJ_BODY, robot_root_) +
                        "'; leeway supports one robot (one top-level body with joints)");
     }
     if (!m.jnt_limited[j])
@@ -118,8 +122,8 @@ void Scene::recognise(const SceneOptions& options) {
     if (m.nuser_jnt > 0) {
       rj.max_speed = m.jnt_user[j * m.nuser_jnt];
       if (!std::isfinite(rj.max_speed) || rj.max_speed < 0)
-        throw InputError(file + ": joint " + label + " user[0] (max speed) '" +
-                         format_number(rj.max_speed) + "' must be a finite value >= 0");
+        throw InputError(file + ": joint " + label + " user[0] (max speed) '" + format_number(rj.max_speed) +
+                         "' must be a finite value >= 0");
     }
     joints_.push_back(rj);
   }
@@ -160,8 +164,9 @@ void Scene::recognise(const SceneOptions& options) {
     }
   }
   if (link_geoms_.empty())
-    throw InputError(file + ": the robot has no collidable geoms on its moving bodies "
-                            "(contype or conaffinity must be non-zero)");
+    throw InputError(file +
+                     ": the robot has no collidable geoms on its moving bodies "
+                     "(contype or conaffinity must be non-zero)");
 
   // Sites: the tool site in the robot, goal sites outside it.
   tool_site_ = mj_name2id(&m, mjOBJ_SITE, options.tool_site.c_str());
@@ -170,8 +175,7 @@ void Scene::recognise(const SceneOptions& options) {
                      "' (the robot's tool site; choose another with --tool)");
   const int tool_body = m.site_bodyid[tool_site_];
   if (tool_body == 0 || top_ancestor(m, tool_body) != robot_root_ || m.body_weldid[tool_body] == 0)
-    throw InputError(file + ": tool site '" + options.tool_site +
-                     "' is not on a moving body of the robot");
+    throw InputError(file + ": tool site '" + options.tool_site + "' is not on a moving body of the robot");
   for (int i = 0; i < m.nsite; ++i) {
     const int b = m.site_bodyid[i];
     if (b == 0 || top_ancestor(m, b) != robot_root_) goal_sites_.push_back(i);
@@ -238,8 +242,8 @@ const Keyframe& Scene::keyframe(const std::string& name) const {
 
 void Scene::validate_configuration(const Eigen::VectorXd& q, const std::string& what) const {
   if (q.size() != dof())
-    throw InputError(what + ": " + std::to_string(q.size()) + " values given, the robot in " +
-                     source_ + " has " + std::to_string(dof()) + " joints");
+    throw InputError(what + ": " + std::to_string(q.size()) + " values given, the robot in " + source_ +
+                     " has " + std::to_string(dof()) + " joints");
   for (int i = 0; i < dof(); ++i)
     if (!std::isfinite(q[i]))
       throw InputError(what + ": joint '" + joints_[static_cast<size_t>(i)].name + "' value '" +

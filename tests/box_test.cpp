@@ -13,7 +13,7 @@ TEST(BoxTest, ContainsAxisAligned) {
   b.center = {1, 2, 3};
   b.half_size = {0.5, 0.25, 1.0};
   EXPECT_TRUE(contains(b, {1, 2, 3}));
-  EXPECT_TRUE(contains(b, {1.5, 2.25, 4.0}));   // a corner: on the surface counts as inside
+  EXPECT_TRUE(contains(b, {1.5, 2.25, 4.0}));  // a corner: on the surface counts as inside
   EXPECT_FALSE(contains(b, {1.51, 2, 3}));
   EXPECT_FALSE(contains(b, {1, 2.26, 3}));
   EXPECT_FALSE(contains(b, {1, 2, 1.99}));
@@ -49,8 +49,10 @@ TEST(BoxPenetrationTest, FaceOverlapIsExact) {
 TEST(BoxPenetrationTest, RotatedCornerIntoFace) {
   // A cube turned 45 degrees about z, centred at x = 1.2: its corner reaches 1.2 - sqrt(2)/2 =
   // 0.49289 m, 0.00711 m into the other cube's face at x = 0.5.
-  EXPECT_NEAR(box_penetration(cube({0, 0, 0}), cube({1.2, 0, 0}, M_PI / 4)), 0.5 + std::sqrt(0.5) - 1.2, 1e-12);
-  EXPECT_NEAR(box_penetration(cube({0, 0, 0}), cube({1.3, 0, 0}, M_PI / 4)), 0.5 + std::sqrt(0.5) - 1.3, 1e-12);
+  EXPECT_NEAR(box_penetration(cube({0, 0, 0}), cube({1.2, 0, 0}, M_PI / 4)), 0.5 + std::sqrt(0.5) - 1.2,
+              1e-12);
+  EXPECT_NEAR(box_penetration(cube({0, 0, 0}), cube({1.3, 0, 0}, M_PI / 4)), 0.5 + std::sqrt(0.5) - 1.3,
+              1e-12);
 }
 
 TEST(BoxPenetrationTest, EdgeEdgeSeparation) {
@@ -62,6 +64,26 @@ TEST(BoxPenetrationTest, EdgeEdgeSeparation) {
   Box upper = cube({0, 0, 1.5});
   upper.rotation = Eigen::AngleAxisd(M_PI / 4, Eigen::Vector3d::UnitY()).toRotationMatrix();
   EXPECT_NEAR(box_penetration(lower, upper), 2 * std::sqrt(0.5) - 1.5, 1e-12);
+}
+
+TEST(BoxDistanceTest, HandComputedGaps) {
+  Eigen::Vector3d pa, pb;
+  // Face to face: 0.25 m, closest points on the facing faces.
+  EXPECT_NEAR(box_distance(cube({0, 0, 0}), cube({1.25, 0.3, 0}), &pa, &pb), 0.25, 1e-9);
+  EXPECT_NEAR(pa.x(), 0.5, 1e-9);
+  EXPECT_NEAR(pb.x(), 0.75, 1e-9);
+  // Corner to corner along the diagonal: (0.5, 0.5, 0.5) to (1, 1, 1) is sqrt(3)/2.
+  EXPECT_NEAR(box_distance(cube({0, 0, 0}), cube({1.5, 1.5, 1.5})), std::sqrt(3.0) / 2, 1e-9);
+  // A 45-degree cube's corner at x = 1.3 - sqrt(2)/2 to the face at x = 0.5.
+  EXPECT_NEAR(box_distance(cube({0, 0, 0}), cube({1.3, 0, 0}, M_PI / 4)), 1.3 - std::sqrt(0.5) - 0.5, 1e-9);
+  // Crossed edges (see EdgeEdgeSeparation): 1.5 - sqrt(2).
+  Box lower = cube({0, 0, 0});
+  lower.rotation = Eigen::AngleAxisd(M_PI / 4, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  Box upper = cube({0, 0, 1.5});
+  upper.rotation = Eigen::AngleAxisd(M_PI / 4, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  EXPECT_NEAR(box_distance(lower, upper), 1.5 - 2 * std::sqrt(0.5), 1e-9);
+  // Overlapping boxes are at distance 0.
+  EXPECT_EQ(box_distance(cube({0, 0, 0}), cube({0.9, 0, 0})), 0.0);
 }
 
 }  // namespace

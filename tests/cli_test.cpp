@@ -9,16 +9,17 @@
 namespace leeway {
 namespace {
 
-using ::testing::HasSubstr;
 using test::one_link_cell;
 using test::run_cli;
 using test::workcell;
+using ::testing::HasSubstr;
 
 TEST(CliTest, CheckExitCodes) {
   test::TempDir dir;
   EXPECT_EQ(run_cli("check " + workcell("dallara")).exit_code, 0);
-  const std::string bad = dir.write("hit.xml", one_link_cell(R"(<geom name="wall" type="box" size="1 0.05 1" pos="0 1 1"/>)",
-                                                        R"(<key name="left" qpos="1.5707963"/>)"));
+  const std::string bad =
+      dir.write("hit.xml", one_link_cell(R"(<geom name="wall" type="box" size="1 0.05 1" pos="0 1 1"/>)",
+                                         R"(<key name="left" qpos="1.5707963"/>)"));
   const auto r = run_cli("check " + bad);
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_THAT(r.out, HasSubstr("collides with obstacle 'wall'"));
@@ -43,8 +44,8 @@ TEST(CliTest, BadInputsExitTwoWithOneMessage) {
   const std::string nan_key = dir.write("nan.xml", one_link_cell("", R"(<key name="k" qpos="nan"/>)"));
   const std::string short_key = dir.write("short.xml", one_link_cell("", R"(<key name="k" qpos="0 0"/>)"));
   const std::string malformed = dir.write("bad.xml", "<mujoco><worldbody>");
-  const std::string no_robot =
-      dir.write("norobot.xml", R"(<mujoco><worldbody><geom name="t" type="box" size="1 1 1"/></worldbody></mujoco>)");
+  const std::string no_robot = dir.write(
+      "norobot.xml", R"(<mujoco><worldbody><geom name="t" type="box" size="1 1 1"/></worldbody></mujoco>)");
   const std::vector<Case> cases = {
       {"check " + dir.path().string() + "/absent.xml", {"absent.xml", "cannot open"}},
       {"check " + malformed, {"bad.xml", "does not compile"}},
@@ -66,7 +67,8 @@ TEST(CliTest, BadInputsExitTwoWithOneMessage) {
 }
 
 TEST(CliTest, FkJsonMatchesThePublishedPosition) {
-  const auto r = run_cli("fk " + workcell("dallara") + " --json --q \"-1.11219 0.734922 0.0866255 -3.14159 -0.749248 -1.11219\"");
+  const auto r = run_cli("fk " + workcell("dallara") +
+                         " --json --q \"-1.11219 0.734922 0.0866255 -3.14159 -0.749248 -1.11219\"");
   ASSERT_EQ(r.exit_code, 0) << r.out;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_NEAR(j.at("position")[0].get<double>(), 0.943, 1e-3);

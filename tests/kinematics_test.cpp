@@ -24,7 +24,10 @@ const PublishedPose kPublished[] = {
     {"dallara", "patch", {-1.11219, 0.734922, 0.0866255, -3.14159, -0.749248, -1.11219}, {943, -1910, 800}},
     {"dallara", "mould", {0.251572, 0.282489, -0.107214, -3.14159, -1.39552, 0.251572}, {1817, 467, 1800}},
     {"baltico", "patch", {0.978215, 0.766918, 0.0255917, -3.14159, -0.778286, 0.978215}, {1218, 1809, 800}},
-    {"baltico", "mould", {2.59301, -0.629514, -2.18935, 1.00597e-16, -1.89352, -0.548579}, {1381, -844, 1800}},
+    {"baltico",
+     "mould",
+     {2.59301, -0.629514, -2.18935, 1.00597e-16, -1.89352, -0.548579},
+     {1381, -844, 1800}},
 };
 
 Eigen::VectorXd published_q(const PublishedPose& p) { return Eigen::Map<const Eigen::VectorXd>(p.q, 6); }
@@ -44,7 +47,8 @@ TEST_F(KinematicsTest, PublishedPairsWithinOneMillimetre) {
     // Every thesis pose has the tool pointing straight down.
     EXPECT_NEAR(pose.rotation(2, 2), -1.0, 1e-5) << p.cell << " " << p.key;
     // The cell's keyframe holds the published values.
-    EXPECT_LT((scene.keyframe(p.key).q - published_q(p)).cwiseAbs().maxCoeff(), 1e-9) << p.cell << " " << p.key;
+    EXPECT_LT((scene.keyframe(p.key).q - published_q(p)).cwiseAbs().maxCoeff(), 1e-9)
+        << p.cell << " " << p.key;
   }
 }
 
@@ -75,8 +79,8 @@ TEST_F(KinematicsTest, ContactDepthAgainstAWall) {
   // At q = pi/2 the link spans y = 0 .. 1; a wall whose near face is at y = 0.95 is penetrated
   // by 0.05 m. At q = 0 the link lies along x and is clear.
   test::TempDir dir;
-  const Scene scene =
-      Scene::load(dir.write("cell.xml", one_link_cell(R"(<geom name="wall" type="box" size="1 0.05 1" pos="0 1 1"/>)")));
+  const Scene scene = Scene::load(
+      dir.write("cell.xml", one_link_cell(R"(<geom name="wall" type="box" size="1 0.05 1" pos="0 1 1"/>)")));
   RobotState state(scene);
   Eigen::VectorXd q(1);
   q << M_PI / 2;
@@ -99,8 +103,32 @@ TEST_F(KinematicsTest, IkRecoversThePublishedPosesOnTheirBranch) {
     ASSERT_TRUE(r.success) << p.cell << " " << p.key;
     EXPECT_LT((state.fk(r.q).position - published_position(p)).norm() * 1000, 1.0) << p.cell << " " << p.key;
     // Same branch: the arm joints that fix the position come back to the published values.
-    EXPECT_LT((r.q.head<3>() - published_q(p).head<3>()).cwiseAbs().maxCoeff(), 2e-3) << p.cell << " " << p.key;
+    EXPECT_LT((r.q.head<3>() - published_q(p).head<3>()).cwiseAbs().maxCoeff(), 2e-3)
+        << p.cell << " " << p.key;
     EXPECT_NEAR(state.fk(r.q).rotation(2, 2), -1.0, 1e-4);
+  }
+}
+
+TEST_F(KinematicsTest, DlrKeyframesAreOurIk) {
+  // The DLR keyframes are derived, not published (docs/workcells.md): tool0 at the thesis's
+  // gripper position, tool down, carriage at the goal's x, elbow up, j6 = j1.
+  const Scene scene = Scene::load(workcell("dlr"));
+  RobotState state(scene);
+  const std::pair<const char*, Eigen::Vector3d> goals[] = {{"patch", {-0.916442, 2.115, 0.800}},
+                                                           {"mould", {-7.60193, 1.70258, 1.200}}};
+  IkOptions opt;
+  opt.locked = {true, false, false, false, false, false, false};  // rail_x
+  for (const auto& [key, goal] : goals) {
+    const Eigen::VectorXd q_file = scene.keyframe(key).q;
+    EXPECT_NEAR(q_file[0], goal.x(), 1e-6) << key;  // carriage policy
+    const Pose pose = state.fk(q_file);
+    EXPECT_LT((pose.position - goal).norm() * 1000, 1.0) << key;
+    EXPECT_NEAR(pose.rotation(2, 2), -1.0, 1e-5) << key;
+    Eigen::VectorXd seed = q_file;
+    seed.segment<3>(1).array() += 0.05;
+    const IkResult r = solve_ik(state, goal, seed, opt);
+    ASSERT_TRUE(r.success) << key;
+    EXPECT_LT((r.q - q_file).cwiseAbs().maxCoeff(), 1e-5) << key;
   }
 }
 

@@ -9,9 +9,9 @@
 namespace leeway {
 namespace {
 
-using ::testing::HasSubstr;
 using test::one_link_cell;
 using test::TempDir;
+using ::testing::HasSubstr;
 
 class SceneTest : public test::MujocoTest {
  protected:
@@ -31,11 +31,11 @@ class SceneTest : public test::MujocoTest {
 };
 
 TEST_F(SceneTest, RecognisesRobotObstaclesSitesAndKeyframes) {
-  const std::string path = dir_.write(
-      "cell.xml", one_link_cell(R"(<geom name="wall" type="box" size="0.05 1 1" pos="0 1.2 1"/>
+  const std::string path =
+      dir_.write("cell.xml", one_link_cell(R"(<geom name="wall" type="box" size="0.05 1 1" pos="0 1.2 1"/>
     <geom name="deco" type="sphere" size="0.1" pos="3 3 3" contype="0" conaffinity="0"/>
     <site name="goal" pos="1 0 0.6"/>)",
-                                R"(<key name="home" qpos="0"/><key name="left" qpos="1.5"/>)"));
+                                           R"(<key name="home" qpos="0"/><key name="left" qpos="1.5"/>)"));
   const Scene s = Scene::load(path);
   ASSERT_EQ(s.dof(), 1);
   EXPECT_EQ(s.joints()[0].name, "j1");
@@ -64,8 +64,8 @@ TEST_F(SceneTest, RecognisesRobotObstaclesSitesAndKeyframes) {
 }
 
 TEST_F(SceneTest, UnknownKeyframeAndSiteListTheKnownOnes) {
-  const std::string path =
-      dir_.write("cell.xml", one_link_cell(R"(<site name="goal" pos="1 0 0.6"/>)", R"(<key name="home" qpos="0"/>)"));
+  const std::string path = dir_.write(
+      "cell.xml", one_link_cell(R"(<site name="goal" pos="1 0 0.6"/>)", R"(<key name="home" qpos="0"/>)"));
   const Scene s = Scene::load(path);
   try {
     s.keyframe("patch");
@@ -112,9 +112,10 @@ TEST_F(SceneTest, TwoRobotsAreRejected) {
 }
 
 TEST_F(SceneTest, UnlimitedJointIsRejected) {
-  expect_error(R"(<mujoco><worldbody><body name="b"><joint name="j" type="hinge"/><geom type="box" size="1 1 1"/>
+  expect_error(
+      R"(<mujoco><worldbody><body name="b"><joint name="j" type="hinge"/><geom type="box" size="1 1 1"/>
       <site name="tool0"/></body></worldbody></mujoco>)",
-               {"joint 'j'", "no range"});
+      {"joint 'j'", "no range"});
 }
 
 TEST_F(SceneTest, MissingToolSite) {
@@ -128,7 +129,8 @@ TEST_F(SceneTest, KeyframeOfWrongLength) {
 }
 
 TEST_F(SceneTest, NanAndInfInKeyframe) {
-  expect_error(one_link_cell("", R"(<key name="bad" qpos="nan"/>)"), {"keyframe 'bad'", "joint 'j1'", "'nan'"});
+  expect_error(one_link_cell("", R"(<key name="bad" qpos="nan"/>)"),
+               {"keyframe 'bad'", "joint 'j1'", "'nan'"});
   expect_error(one_link_cell("", R"(<key name="huge" qpos="inf"/>)"), {"keyframe 'huge'", "'inf'"});
   // MuJoCo's parser warns about the NaN itself; that warning is expected here.
   const auto warnings = take_mujoco_warnings();

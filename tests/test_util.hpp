@@ -89,10 +89,12 @@ inline std::string one_link_cell(const std::string& world, const std::string& ke
         <site name="tool0" pos="1 0 0"/>
       </body>
     </body>
-)" + world + R"(
+)" + world +
+         R"(
   </worldbody>
   <keyframe>
-)" + keys + R"(
+)" + keys +
+         R"(
   </keyframe>
 </mujoco>
 )";

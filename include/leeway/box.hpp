@@ -26,6 +26,15 @@ bool contains(const Box& box, const Eigen::Vector3d& p);
 //! lower bound of the true distance).
 double box_penetration(const Box& a, const Box& b);
 
+//! Closest point of the box to p (p itself when inside).
+Eigen::Vector3d closest_point(const Box& box, const Eigen::Vector3d& p);
+
+//! Euclidean distance [m] between two oriented boxes (0 when they touch or overlap), with the
+//! closest points when the out-pointers are given. Alternating projections between the two convex
+//! sets, which converge to a closest pair; stopped when a step moves less than 1e-12 m.
+double box_distance(const Box& a, const Box& b, Eigen::Vector3d* on_a = nullptr,
+                    Eigen::Vector3d* on_b = nullptr);
+
 //! World-frame box of a geom after kinematics: exact for boxes; for other types the box bounds the
 //! geom in its own frame (sphere, capsule, cylinder, ellipsoid), or is the cube of its bounding
 //! sphere (mesh, height field). Planes have no finite box: the returned half-size is infinite.

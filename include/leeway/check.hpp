@@ -16,10 +16,10 @@ namespace leeway {
 
 //! Options of the checker.
 struct CheckOptions {
-  double goal_dz = 0.01;             //!< Algorithm 1 descent step [m]
-  double overlap_tolerance = 1e-4;   //!< obstacle overlaps deeper than this are reported [m]
-  double reach_tolerance = 1e-3;     //!< a site is reachable when IK gets this close [m]
-  std::uint64_t seed = 1;            //!< seed of the IK restarts
+  double goal_dz = 0.01;            //!< Algorithm 1 descent step [m]
+  double overlap_tolerance = 1e-4;  //!< obstacle overlaps deeper than this are reported [m]
+  double reach_tolerance = 1e-3;    //!< a site is reachable when IK gets this close [m]
+  std::uint64_t seed = 1;           //!< seed of the IK restarts
 };
 
 //! Findings for one keyframe.
@@ -29,15 +29,16 @@ struct KeyframeFindings {
   Pose tool;
   std::vector<Contact> collisions;
   std::vector<int> limit_violations;  //!< joint indices
+  Clearance clearance;                //!< closest link-obstacle pair
 };
 
 //! Findings for one goal site.
 struct GoalFindings {
   std::string site;
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
-  int goal_obstacle = -1;  //!< geom id found by Algorithm 1, -1 when none lies below
-  bool reachable = false;  //!< some configuration within limits puts the tool site there
-  double reach_error = 0;  //!< closest approach of the tool site [m]
+  int goal_obstacle = -1;            //!< geom id found by Algorithm 1, -1 when none lies below
+  bool reachable = false;            //!< some configuration within limits puts the tool site there
+  double reach_error = 0;            //!< closest approach of the tool site [m]
   bool reachable_tool_down = false;  //!< ... with the tool pointing down and collision-free
   Eigen::VectorXd q_tool_down;       //!< that configuration (when reachable_tool_down)
 };

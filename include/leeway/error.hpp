@@ -22,10 +22,11 @@ enum ExitCode : int {
 };
 
 //! Always-on internal invariant check: throws std::logic_error naming the condition.
-#define LEEWAY_DEMAND(cond)                                                                  \
-  do {                                                                                       \
-    if (!(cond)) throw std::logic_error(std::string("leeway internal check failed: ") + #cond \
-                                        + " at " + __FILE__ + ":" + std::to_string(__LINE__)); \
+#define LEEWAY_DEMAND(cond)                                                                              \
+  do {                                                                                                   \
+    if (!(cond))                                                                                         \
+      throw std::logic_error(std::string("leeway internal check failed: ") + #cond + " at " + __FILE__ + \
+                             ":" + std::to_string(__LINE__));                                            \
   } while (false)
 
 }  // namespace leeway

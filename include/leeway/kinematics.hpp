@@ -4,6 +4,7 @@
 //! mjData: use one per thread with a shared const Scene.
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -26,6 +27,13 @@ struct Contact {
   double depth = 0.0;
 };
 
+//! The smallest distance between the robot's links and the obstacles.
+struct Clearance {
+  double distance = INFINITY;  //!< [m]; 0 in contact
+  int link_geom = -1;
+  int obstacle_geom = -1;
+};
+
 //! Forward kinematics and collision queries for one thread.
 class RobotState {
  public:
@@ -46,6 +54,9 @@ class RobotState {
   bool in_collision(const Eigen::VectorXd& q);
   //! All robot-link-versus-obstacle contacts at q (deepest first).
   std::vector<Contact> contacts(const Eigen::VectorXd& q);
+  //! Clearance between robot links and obstacles at q: exact box-to-box distances (non-box geoms
+  //! by their bounding boxes, so a lower bound for them; planes are skipped).
+  Clearance clearance(const Eigen::VectorXd& q);
   //! 6 x dof Jacobian of the tool site (rows: linear, then angular) at the last set() q.
   Eigen::MatrixXd tool_jacobian();
 
@@ -60,14 +71,14 @@ class RobotState {
 
 //! Options of the numerical inverse kinematics.
 struct IkOptions {
-  bool tool_down = true;        //!< also require the tool z-axis along world -z (every thesis pose)
-  std::vector<bool> locked;     //!< joints kept at the seed value (empty: none)
-  int restarts = 24;            //!< random restarts after the seed itself
-  std::uint64_t seed = 1;       //!< RNG seed of the restarts
+  bool tool_down = true;                //!< also require the tool z-axis along world -z (every thesis pose)
+  std::vector<bool> locked;             //!< joints kept at the seed value (empty: none)
+  int restarts = 24;                    //!< random restarts after the seed itself
+  std::uint64_t seed = 1;               //!< RNG seed of the restarts
   double position_tolerance = 1e-5;     //!< [m]
   double orientation_tolerance = 1e-5;  //!< |z_tool - (-e_z)|, dimensionless
-  int max_iterations = 400;     //!< per start
-  bool require_collision_free = true;  //!< reject solutions in collision with the obstacles
+  int max_iterations = 400;             //!< per start
+  bool require_collision_free = true;   //!< reject solutions in collision with the obstacles
 };
 
 //! Result of inverse kinematics.

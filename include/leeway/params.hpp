@@ -1,0 +1,91 @@
+#pragma once
+//! @file params.hpp
+//! Every parameter of the joint-boundary algorithm in one plain struct, with JSON I/O.
+//! Defaults are the thesis's (section 4.1) converted to SI units. docs/algorithm.md documents each.
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace leeway {
+
+//! How the height function measures the distance from a cell to a box.
+enum class DistanceMode {
+  kPlane,  //!< in the floor plane, from the cell centre to the box's footprint (default)
+  k3d,     //!< in 3D, from the cell centre on the floor (z = 0) to the box
+};
+
+//! The height-map of section 3.2.1.
+struct HeightMapParams {
+  //! When true, the map is the rectangle covering every floor point within reach_radius of every
+  //! arm-base position along the path (cells beyond reach hold no box anyway); origin_x/origin_y/
+  //! x_dim/y_dim are then ignored.
+  bool auto_extent = true;
+  double origin_x = 0.0;  //!< lower-left corner of the map [m]
+  double origin_y = 0.0;  //!< [m]
+  double x_dim = 0.0;     //!< map size along x [m]
+  double y_dim = 0.0;     //!< map size along y [m]
+  int max_cells = 20000;  //!< MAX_cells: side = sqrt(x_dim * y_dim / MAX_cells)
+};
+
+//! The height function, eq. 3.1 with the goal term of eq. 4.1, and the activation A_t.
+struct VolumeParams {
+  double d_t_lb = 0.35;             //!< trail term lower bound [m]
+  double d_t_ub = 1.50;             //!< trail term upper bound [m]
+  double d_g_lb = 0.10;             //!< goal term lower bound [m]
+  double d_g_ub = 2.00;             //!< goal term upper bound [m]
+  double d_ng_ub = 0.50;            //!< non-goal obstacle term upper bound [m]
+  double h_max = 1.50;              //!< largest contribution of one term [m]
+  double alpha_t = 1.0;             //!< exponent of the trail term
+  double alpha_g = 1.0;             //!< exponent of the goal term
+  double alpha_ng = 1.0;            //!< exponent of the non-goal term
+  bool goal_constant_term = true;   //!< eq. 4.1: h_max/3 + 2/3 h_max (...)^alpha_g instead of eq. 3.1's term
+  double reach_radius = 2.8;        //!< A_t = 0 beyond this distance from the arm's base [m] (DLR: 3.0)
+  bool add_obstacle_boxes = false;  //!< DLR option: the obstacles' own boxes join the volume
+  DistanceMode distance = DistanceMode::kPlane;
+};
+
+//! Categorisation (section 3.1).
+struct CategorizeParams {
+  double goal_dz = 0.01;  //!< Algorithm 1 descent step ΔZ [m]
+  int trail_densify = 0;  //!< extra trail poses per path segment (0: waypoints only, as the thesis)
+};
+
+//! Bounding (section 3.3).
+struct BoundsParams {
+  double resolution = 0.01;  //!< Algorithm 2's Δ [rad, or m for slide joints]
+  //! collapse guard: an interval narrower than this on a side is widened to it [rad or m]
+  double min_half_width = 0.01;
+  double wrist_half_width = 0.2;        //!< fixed half-width of joints 4-6 around nominal [rad]
+  double linear_axis_tolerance = 0.03;  //!< slide joints: half-width as a fraction of the joint's range
+};
+
+//! Confidence Factor (section 4.1).
+struct CfParams {
+  int windows = 30;        //!< the path is split into this many windows
+  int samples = 10000;     //!< random configurations per window
+  std::uint64_t seed = 1;  //!< RNG seed
+};
+
+//! All parameters.
+struct Params {
+  HeightMapParams height_map;
+  VolumeParams volume;
+  CategorizeParams categorize;
+  BoundsParams bounds;
+  CfParams cf;
+
+  //! @throws InputError naming the parameter and value when one is out of range (NaN, negative
+  //! lengths, LB >= UB, MAX_cells <= 0, ...).
+  void validate() const;
+};
+
+//! Parameters as JSON (every field, SI units in the key documentation).
+nlohmann::json to_json(const Params& p);
+//! Parameters from JSON: missing keys keep their defaults, unknown keys are an error.
+//! @throws InputError naming `source`, the key and the value.
+Params params_from_json(const nlohmann::json& j, const std::string& source);
+//! Reads and validates a parameter file. @throws InputError naming the file.
+Params read_params(const std::string& path);
+
+}  // namespace leeway

@@ -1,0 +1,247 @@
+#include "leeway/params.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <set>
+#include <string>
+#include <type_traits>
+
+#include "leeway/error.hpp"
+#include "leeway/scene.hpp"
+
+namespace leeway {
+namespace {
+
+using nlohmann::json;
+
+//! Calls f(section, key, field) for every parameter, in the order of params.hpp. The one list that
+//! to_json, params_from_json and validate() share, so that a new field cannot be forgotten in one.
+template <class P, class F>
+void for_each_field(P& p, F&& f) {
+  f("height_map", "auto_extent", p.height_map.auto_extent);
+  f("height_map", "origin_x", p.height_map.origin_x);
+  f("height_map", "origin_y", p.height_map.origin_y);
+  f("height_map", "x_dim", p.height_map.x_dim);
+  f("height_map", "y_dim", p.height_map.y_dim);
+  f("height_map", "max_cells", p.height_map.max_cells);
+  f("volume", "d_t_lb", p.volume.d_t_lb);
+  f("volume", "d_t_ub", p.volume.d_t_ub);
+  f("volume", "d_g_lb", p.volume.d_g_lb);
+  f("volume", "d_g_ub", p.volume.d_g_ub);
+  f("volume", "d_ng_ub", p.volume.d_ng_ub);
+  f("volume", "h_max", p.volume.h_max);
+  f("volume", "alpha_t", p.volume.alpha_t);
+  f("volume", "alpha_g", p.volume.alpha_g);
+  f("volume", "alpha_ng", p.volume.alpha_ng);
+  f("volume", "goal_constant_term", p.volume.goal_constant_term);
+  f("volume", "reach_radius", p.volume.reach_radius);
+  f("volume", "add_obstacle_boxes", p.volume.add_obstacle_boxes);
+  f("volume", "distance", p.volume.distance);
+  f("categorize", "goal_dz", p.categorize.goal_dz);
+  f("categorize", "trail_densify", p.categorize.trail_densify);
+  f("bounds", "resolution", p.bounds.resolution);
+  f("bounds", "min_half_width", p.bounds.min_half_width);
+  f("bounds", "wrist_half_width", p.bounds.wrist_half_width);
+  f("bounds", "linear_axis_tolerance", p.bounds.linear_axis_tolerance);
+  f("cf", "windows", p.cf.windows);
+  f("cf", "samples", p.cf.samples);
+  f("cf", "seed", p.cf.seed);
+}
+
+const char* distance_name(DistanceMode m) { return m == DistanceMode::k3d ? "3d" : "plane"; }
+
+std::string value_text(double v) { return format_number(v); }
+std::string value_text(int v) { return std::to_string(v); }
+
+//! "parameter 'volume.d_t_lb' = 2"
+template <class T>
+std::string describe(const char* key, T value) {
+  return std::string("parameter '") + key + "' = " + value_text(value);
+}
+
+void require_positive(const char* key, double v) {
+  if (!(v > 0)) throw InputError(describe(key, v) + " must be > 0");
+}
+void require_non_negative(const char* key, double v) {
+  if (!(v >= 0)) throw InputError(describe(key, v) + " must be >= 0");
+}
+template <class T>
+void require_between(const char* key, T v, T lo, T hi) {
+  if (!(v >= lo && v <= hi))
+    throw InputError(describe(key, v) + " must be between " + value_text(lo) + " and " + value_text(hi));
+}
+void require_smaller(const char* lb_key, double lb, const char* ub_key, double ub) {
+  if (!(lb < ub))
+    throw InputError(describe(lb_key, lb) + " must be smaller than '" + ub_key + "' = " + value_text(ub));
+}
+
+//! A JSON value for an error message, shortened when long.
+std::string shown(const json& v) {
+  std::string s = v.dump();
+  if (s.size() > 60) s = s.substr(0, 57) + "...";
+  return s;
+}
+
+[[noreturn]] void wrong_type(const std::string& source, const std::string& key, const char* expected,
+                             const json& v) {
+  throw InputError(source + ": parameter '" + key + "' must be " + expected + ", got " + v.type_name() + " " +
+                   shown(v));
+}
+
+void read_value(const json& v, const std::string& key, const std::string& source, bool& out) {
+  if (!v.is_boolean()) wrong_type(source, key, "true or false", v);
+  out = v.get<bool>();
+}
+
+void read_value(const json& v, const std::string& key, const std::string& source, double& out) {
+  if (!v.is_number()) wrong_type(source, key, "a number", v);
+  out = v.get<double>();
+}
+
+void read_value(const json& v, const std::string& key, const std::string& source, int& out) {
+  // JSON integers only: 2.5 or 2.0 for a count is more likely a mistake than intended.
+  if (!v.is_number_integer()) wrong_type(source, key, "an integer", v);
+  constexpr auto kMax = std::numeric_limits<int>::max();
+  constexpr auto kMin = std::numeric_limits<int>::min();
+  if (v.is_number_unsigned() ? v.get<std::uint64_t>() > static_cast<std::uint64_t>(kMax)
+                             : (v.get<std::int64_t>() > kMax || v.get<std::int64_t>() < kMin))
+    throw InputError(source + ": parameter '" + key + "' = " + shown(v) + " is out of the integer range");
+  out = v.get<int>();
+}
+
+void read_value(const json& v, const std::string& key, const std::string& source, std::uint64_t& out) {
+  if (!v.is_number_unsigned()) wrong_type(source, key, "an integer >= 0", v);
+  out = v.get<std::uint64_t>();
+}
+
+void read_value(const json& v, const std::string& key, const std::string& source, DistanceMode& out) {
+  if (v.is_string() && v.get<std::string>() == "plane")
+    out = DistanceMode::kPlane;
+  else if (v.is_string() && v.get<std::string>() == "3d")
+    out = DistanceMode::k3d;
+  else
+    wrong_type(source, key, "\"plane\" or \"3d\"", v);
+}
+
+std::string join(const std::set<std::string>& names) {
+  std::string s;
+  for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
+  return s;
+}
+
+}  // namespace
+
+void Params::validate() const {
+  for_each_field(*this, [](const char* section, const char* key, const auto& field) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(field)>, double>) {
+      if (!std::isfinite(field))
+        throw InputError(describe((std::string(section) + "." + key).c_str(), field) +
+                         " must be a finite number");
+    }
+  });
+  const HeightMapParams& hm = height_map;
+  require_between("height_map.max_cells", hm.max_cells, 1, 1000000);
+  if (!hm.auto_extent) {
+    // Explicit extents only matter (and are only checked) when auto_extent is off.
+    if (!(hm.x_dim > 0))
+      throw InputError(describe("height_map.x_dim", hm.x_dim) +
+                       " must be > 0 when 'height_map.auto_extent' is false");
+    if (!(hm.y_dim > 0))
+      throw InputError(describe("height_map.y_dim", hm.y_dim) +
+                       " must be > 0 when 'height_map.auto_extent' is false");
+  }
+  const VolumeParams& v = volume;
+  require_non_negative("volume.d_t_lb", v.d_t_lb);
+  require_smaller("volume.d_t_lb", v.d_t_lb, "volume.d_t_ub", v.d_t_ub);
+  require_non_negative("volume.d_g_lb", v.d_g_lb);
+  require_smaller("volume.d_g_lb", v.d_g_lb, "volume.d_g_ub", v.d_g_ub);
+  require_positive("volume.d_ng_ub", v.d_ng_ub);
+  require_positive("volume.h_max", v.h_max);
+  require_positive("volume.alpha_t", v.alpha_t);
+  require_positive("volume.alpha_g", v.alpha_g);
+  require_positive("volume.alpha_ng", v.alpha_ng);
+  require_positive("volume.reach_radius", v.reach_radius);
+  if (v.distance != DistanceMode::kPlane && v.distance != DistanceMode::k3d)
+    throw InputError("parameter 'volume.distance' = " + std::to_string(static_cast<int>(v.distance)) +
+                     " must be plane or 3d");
+  require_positive("categorize.goal_dz", categorize.goal_dz);
+  require_between("categorize.trail_densify", categorize.trail_densify, 0, 1000);
+  require_positive("bounds.resolution", bounds.resolution);
+  require_non_negative("bounds.min_half_width", bounds.min_half_width);
+  require_non_negative("bounds.wrist_half_width", bounds.wrist_half_width);
+  require_between("bounds.linear_axis_tolerance", bounds.linear_axis_tolerance, 0.0, 1.0);
+  require_between("cf.windows", cf.windows, 1, std::numeric_limits<int>::max());
+  require_between("cf.samples", cf.samples, 1, std::numeric_limits<int>::max());
+}
+
+nlohmann::json to_json(const Params& p) {
+  json j = json::object();
+  for_each_field(p, [&](const char* section, const char* key, const auto& field) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(field)>, DistanceMode>)
+      j[section][key] = distance_name(field);
+    else
+      j[section][key] = field;
+  });
+  return j;
+}
+
+Params params_from_json(const nlohmann::json& j, const std::string& source) {
+  Params p;
+  if (!j.is_object())
+    throw InputError(source + ": the parameters must be a JSON object, got " + j.type_name() + " " +
+                     shown(j));
+
+  // Unknown keys first, at both levels: a misspelt key would otherwise silently keep its default.
+  std::map<std::string, std::set<std::string>> known;
+  for_each_field(p, [&](const char* section, const char* key, const auto&) { known[section].insert(key); });
+  std::set<std::string> sections;
+  for (const auto& entry : known) sections.insert(entry.first);
+  for (const auto& [section, body] : j.items()) {
+    const auto it = known.find(section);
+    if (it == known.end())
+      throw InputError(source + ": unknown parameter '" + section + "' (known sections: " + join(sections) +
+                       ")");
+    if (!body.is_object())
+      throw InputError(source + ": parameter '" + section + "' must be an object, got " + body.type_name() +
+                       " " + shown(body));
+    for (const auto& item : body.items())
+      if (it->second.count(item.key()) == 0)
+        throw InputError(source + ": unknown parameter '" + section + "." + item.key() + "' (known in '" +
+                         section + "': " + join(it->second) + ")");
+  }
+
+  for_each_field(p, [&](const char* section, const char* key, auto& field) {
+    const auto s = j.find(section);
+    if (s == j.end()) return;
+    const auto k = s->find(key);
+    if (k == s->end()) return;
+    read_value(*k, std::string(section) + "." + key, source, field);
+  });
+
+  try {
+    p.validate();
+  } catch (const InputError& e) {
+    throw InputError(source + ": " + e.what());
+  }
+  return p;
+}
+
+Params read_params(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open the parameter file");
+  json j;
+  try {
+    j = json::parse(in);
+  } catch (const json::parse_error& e) {
+    std::string message = e.what();
+    for (char& ch : message)
+      if (ch == '\n' || ch == '\r') ch = ' ';
+    throw InputError(path + ": malformed JSON: " + message);
+  }
+  return params_from_json(j, path);
+}
+
+}  // namespace leeway

@@ -27,17 +27,18 @@ struct ArrayInfo {
 
 std::vector<ArrayInfo> model_arrays(const mjModel* m) {
   std::vector<ArrayInfo> out;
+  // X-macro expansion from mjxmacro.h, kept as written:
+  // clang-format off
   MJMODEL_POINTERS_PREAMBLE(m)
 #define X(type, name, nr, nc)                                                                   \
   out.push_back({#name, sizeof(type), std::strcmp(#nr, "ngeom") == 0, static_cast<long>(m->nr), \
                  static_cast<long>(nc), reinterpret_cast<const char*>(m->name)});
   MJMODEL_POINTERS
 #undef X
-      (void)
-      nuser_body,
-      (void)nuser_jnt, (void)nuser_geom, (void)nuser_site, (void)nuser_cam;
+  (void)nuser_body, (void)nuser_jnt, (void)nuser_geom, (void)nuser_site, (void)nuser_cam;
   (void)nuser_tendon, (void)nuser_actuator, (void)nuser_sensor, (void)nq, (void)nv, (void)na, (void)nu;
   (void)nmocap;
+  // clang-format on
   return out;
 }
 

@@ -52,6 +52,8 @@ TEST_F(VolumeWorldTest, GrownModelEqualsTheCompiledOne) {
   const mjModel* b = many.get();
   int compared = 0;
   {
+    // X-macro expansion from mjxmacro.h, kept as written:
+    // clang-format off
     MJMODEL_POINTERS_PREAMBLE(a)
 #define X(type, name, nr, nc)                                                                               \
   if (compare_array(#name)) {                                                                               \
@@ -61,11 +63,10 @@ TEST_F(VolumeWorldTest, GrownModelEqualsTheCompiledOne) {
   }
     MJMODEL_POINTERS
 #undef X
-        (void)
-        nuser_body,
-        (void)nuser_jnt, (void)nuser_geom, (void)nuser_site, (void)nuser_cam;
+  (void)nuser_body, (void)nuser_jnt, (void)nuser_geom, (void)nuser_site, (void)nuser_cam;
     (void)nuser_tendon, (void)nuser_actuator, (void)nuser_sensor, (void)nq, (void)nv, (void)na, (void)nu;
     (void)nmocap;
+    // clang-format on
   }
   EXPECT_GT(compared, 100);
 }

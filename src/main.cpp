@@ -2,12 +2,17 @@
 #include <CLI/CLI.hpp>
 
 #include <cmath>
+#include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
 
 #include "leeway/check.hpp"
 #include "leeway/error.hpp"
 #include "leeway/kinematics.hpp"
+#include "leeway/pipeline.hpp"
 #include "leeway/scene.hpp"
 
 namespace {
@@ -49,6 +54,37 @@ Eigen::VectorXd configuration(const leeway::Scene& scene, const std::string& q, 
 }
 
 std::string joint_unit(const leeway::RobotJoint& j) { return j.prismatic ? "m" : "rad"; }
+
+// Parameters: defaults, then the cell's own (MJCF custom numerics), then a --params file, then flags.
+leeway::Params load_params(const leeway::Scene& scene, const std::string& file) {
+  leeway::Params p;
+  if (file.empty()) {
+    leeway::apply_cell_defaults(scene, p);
+  } else {
+    p = leeway::read_params(file);
+  }
+  return p;
+}
+
+int default_threads() { return std::max(1, static_cast<int>(std::thread::hardware_concurrency())); }
+
+std::vector<int> parse_cells_list(const std::string& text) {
+  std::vector<int> out;
+  const Eigen::VectorXd v = leeway::parse_vector(text, "--max-cells");
+  for (Eigen::Index i = 0; i < v.size(); ++i) {
+    if (v[i] != std::floor(v[i]) || v[i] < 1 || v[i] > 1e6)
+      throw InputError("--max-cells value '" + leeway::format_number(v[i]) +
+                       "' must be a whole number from 1 to 1000000");
+    out.push_back(static_cast<int>(v[i]));
+  }
+  if (out.empty()) throw InputError("--max-cells lists no value");
+  return out;
+}
+
+// The thesis's 20 MAX_cells values (section 4.1).
+const char* kThesisCells =
+    "100,150,200,500,750,1000,1500,2000,3000,5000,7500,10000,12000,15000,20000,25000,30000,40000,50000,"
+    "100000";
 
 }  // namespace
 
@@ -109,11 +145,71 @@ int main(int argc, char** argv) {
   ik->add_flag("--json", ik_json, "Print JSON");
   add_tool(ik);
 
+  // bounds
+  std::string b_file, b_from, b_to, b_params, b_out;
+  int b_cells = 0, b_waypoints = 2, b_threads = default_threads();
+  bool b_json = false;
+  CLI::App* bounds = app.add_subcommand(
+      "bounds", "Joint bounds along the path between two keyframes (thesis chapter 3). Exit 0 on success.");
+  bounds->add_option("cell", b_file, "MJCF file of the workcell")->required();
+  bounds->add_option("--from", b_from, "Keyframe the path starts at")->required();
+  bounds->add_option("--to", b_to, "Keyframe the path ends at")->required();
+  bounds
+      ->add_option("--waypoints", b_waypoints, "Waypoints along the joint-linear path (>= 2; the thesis: 2)")
+      ->capture_default_str();
+  bounds->add_option("--max-cells", b_cells, "MAX_cells of the height-map (default: from --params, 20000)");
+  bounds->add_option("--params", b_params, "Parameter file (JSON; see leeway params)");
+  bounds->add_option("--out", b_out, "Write the bounds file here (JSON)");
+  bounds->add_option("--threads", b_threads, "Worker threads")->capture_default_str();
+  bounds->add_flag("--json", b_json, "Print the bounds file to standard output");
+
+  // cf
+  std::string c_file, c_bounds;
+  bool c_json = false;
+  int c_threads = default_threads();
+  leeway::CfParams c_params;
+  CLI::App* cf =
+      app.add_subcommand("cf", "Confidence Factor of a bounds file against the real obstacles (section 4.1)");
+  cf->add_option("cell", c_file, "MJCF file of the workcell")->required();
+  cf->add_option("bounds", c_bounds, "Bounds file written by leeway bounds --out")->required();
+  cf->add_option("--windows", c_params.windows, "Windows along the path")->capture_default_str();
+  cf->add_option("--samples", c_params.samples, "Random configurations per window")->capture_default_str();
+  cf->add_option("--seed", c_params.seed, "Random seed")->capture_default_str();
+  cf->add_option("--threads", c_threads, "Worker threads")->capture_default_str();
+  cf->add_flag("--json", c_json, "Print JSON");
+
+  // sweep
+  std::string s_file, s_from, s_to, s_params, s_cells = kThesisCells, s_csv;
+  int s_threads = default_threads(), s_waypoints = 2;
+  leeway::CfParams s_cf;
+  CLI::App* sweep = app.add_subcommand(
+      "sweep", "The thesis's table: for each MAX_cells, boxes, time [ms] and CF [%], as Markdown (and CSV)");
+  sweep->add_option("cell", s_file, "MJCF file of the workcell")->required();
+  sweep->add_option("--from", s_from, "Keyframe the path starts at")->required();
+  sweep->add_option("--to", s_to, "Keyframe the path ends at")->required();
+  sweep->add_option("--waypoints", s_waypoints, "Waypoints along the joint-linear path")
+      ->capture_default_str();
+  sweep->add_option("--max-cells", s_cells, "Comma-separated MAX_cells values (default: the thesis's 20)");
+  sweep->add_option("--params", s_params, "Parameter file (JSON)");
+  sweep->add_option("--csv", s_csv, "Also write the table as CSV here");
+  sweep->add_option("--windows", s_cf.windows, "CF windows")->capture_default_str();
+  sweep->add_option("--samples", s_cf.samples, "CF samples per window")->capture_default_str();
+  sweep->add_option("--seed", s_cf.seed, "CF random seed")->capture_default_str();
+  sweep->add_option("--threads", s_threads, "Worker threads")->capture_default_str();
+
+  // params
+  std::string p_file;
+  CLI::App* params_cmd =
+      app.add_subcommand("params", "Print the default parameters as JSON (SI units), or a cell's");
+  params_cmd->add_option("cell", p_file, "Also apply this cell's own defaults (MJCF custom numerics)");
+
   try {
     // CLI11 would only say "A subcommand is required" for a mistyped one: name it.
     const std::string first = argc > 1 ? argv[1] : "";
-    if (!first.empty() && first[0] != '-' && first != "check" && first != "fk" && first != "ik") {
-      std::cerr << "leeway: error: unknown subcommand '" << first << "'; subcommands: check, fk, ik "
+    if (!first.empty() && first[0] != '-' && first != "check" && first != "fk" && first != "ik" &&
+        first != "bounds" && first != "cf" && first != "sweep" && first != "params") {
+      std::cerr << "leeway: error: unknown subcommand '" << first
+                << "'; subcommands: check, fk, ik, bounds, cf, sweep, params "
                 << "(see leeway --help)\n";
       return leeway::kExitBadInput;
     }
@@ -223,6 +319,110 @@ int main(int argc, char** argv) {
                   << result.orientation_error << "\n";
       }
       return result.success ? leeway::kExitOk : leeway::kExitFindings;
+    }
+    if (*bounds) {
+      const auto scene = leeway::Scene::load(b_file, scene_opts);
+      leeway::Params p = load_params(scene, b_params);
+      if (b_cells != 0) p.height_map.max_cells = b_cells;
+      p.validate();
+      if (b_threads < 1) throw InputError("--threads " + std::to_string(b_threads) + " must be >= 1");
+      const auto path = leeway::keyframe_path(scene, b_from, b_to, b_waypoints);
+      leeway::VolumeModel world(scene,
+                                p.height_map.max_cells + static_cast<int>(scene.obstacle_geoms().size()));
+      const auto run = leeway::compute_bounds(scene, world, path, p, b_threads);
+      const json out = leeway::bounds_json(scene, run, p);
+      if (!b_out.empty()) leeway::write_file_atomic(b_out, out.dump(2) + "\n");
+      if (b_json) {
+        std::cout << out.dump(2) << "\n";
+      } else {
+        std::cout << scene.source() << " " << b_from << " -> " << b_to << " (units: rad, m, ms)\n";
+        std::cout << "MAX_cells " << p.height_map.max_cells << ", boxes " << run.volume.boxes.size()
+                  << ", goal obstacle " << out["goal_obstacle"].dump() << ", collision checks " << run.checks
+                  << "\n";
+        std::cout << std::fixed << std::setprecision(4);
+        for (size_t w = 0; w < run.bounds.size(); ++w) {
+          std::cout << "waypoint " << w << ":\n";
+          for (int i = 0; i < scene.dof(); ++i)
+            std::cout << "  " << std::setw(8) << scene.joints()[static_cast<size_t>(i)].name << "  ["
+                      << run.bounds[w].lower[i] << ", " << run.bounds[w].upper[i] << "]  nominal "
+                      << run.bounds[w].q[i]
+                      << (run.bounds[w].collapsed[static_cast<size_t>(i)] ? "  (collapsed, widened)" : "")
+                      << "\n";
+        }
+        std::cout << std::setprecision(1) << "time [ms]: categorize " << run.ms_categorize << ", volume "
+                  << run.ms_volume << ", inject " << run.ms_inject << ", bounds " << run.ms_bounds
+                  << ", total " << run.ms_total() << "\n";
+        if (!b_out.empty()) std::cout << "wrote " << b_out << "\n";
+      }
+      return leeway::kExitOk;
+    }
+
+    if (*cf) {
+      const auto scene = leeway::Scene::load(c_file, scene_opts);
+      if (c_threads < 1) throw InputError("--threads " + std::to_string(c_threads) + " must be >= 1");
+      const auto wb = leeway::read_bounds(c_bounds, scene);
+      const auto r = leeway::confidence_factor(scene, wb, c_params, c_threads);
+      if (c_json) {
+        json out = {{"cf", r.cf},
+                    {"ci95", {r.ci_low, r.ci_high}},
+                    {"worst_window", {{"index", r.worst_window}, {"cf", r.worst_window_cf}}},
+                    {"window_cf", r.window_cf},
+                    {"samples", r.samples},
+                    {"collisions", r.collisions},
+                    {"windows", c_params.windows},
+                    {"seed", c_params.seed},
+                    {"units", "cf and ci95 are fractions (1 = 100 %)"}};
+        std::cout << out.dump(2) << "\n";
+      } else {
+        std::cout << std::fixed << std::setprecision(4) << "CF " << 100 * r.cf << " % (95 % CI "
+                  << 100 * r.ci_low << " .. " << 100 * r.ci_high << " %), " << r.collisions << " of "
+                  << r.samples << " samples collide; worst window " << r.worst_window << " of "
+                  << c_params.windows << ": " << 100 * r.worst_window_cf << " %\n";
+      }
+      return leeway::kExitOk;
+    }
+
+    if (*sweep) {
+      const auto scene = leeway::Scene::load(s_file, scene_opts);
+      const leeway::Params base = load_params(scene, s_params);
+      const std::vector<int> cells = parse_cells_list(s_cells);
+      if (s_threads < 1) throw InputError("--threads " + std::to_string(s_threads) + " must be >= 1");
+      const auto path = leeway::keyframe_path(scene, s_from, s_to, s_waypoints);
+      for (int c : cells) {
+        leeway::Params p = base;
+        p.height_map.max_cells = c;
+        p.validate();
+      }
+      leeway::VolumeModel world(scene, *std::max_element(cells.begin(), cells.end()) +
+                                           static_cast<int>(scene.obstacle_geoms().size()));
+      std::ostringstream md, csv;
+      md << "| Max CBox | CBox | Computational Time [ms] | Confidence Factor [%] | 95 % CI [%] | worst "
+            "window [%] |\n"
+         << "|---:|---:|---:|---:|---|---:|\n";
+      csv << "max_cells,boxes,time_ms,volume_ms,bounds_ms,checks,cf,ci_low,ci_high,worst_window_cf\n";
+      for (int c : cells) {
+        leeway::Params p = base;
+        p.height_map.max_cells = c;
+        const auto run = leeway::compute_bounds(scene, world, path, p, s_threads);
+        const auto r = leeway::confidence_factor(scene, run.bounds, s_cf, s_threads);
+        md << std::fixed << "| " << c << " | " << run.volume.boxes.size() << " | " << std::setprecision(1)
+           << run.ms_total() << " | " << std::setprecision(4) << 100 * r.cf << " | " << 100 * r.ci_low
+           << " .. " << 100 * r.ci_high << " | " << 100 * r.worst_window_cf << " |\n";
+        csv << c << "," << run.volume.boxes.size() << "," << std::setprecision(3) << run.ms_total() << ","
+            << run.ms_volume << "," << run.ms_bounds << "," << run.checks << "," << std::setprecision(6)
+            << r.cf << "," << r.ci_low << "," << r.ci_high << "," << r.worst_window_cf << "\n";
+        std::cerr << "max_cells " << c << " done\n";
+      }
+      std::cout << md.str();
+      if (!s_csv.empty()) leeway::write_file_atomic(s_csv, csv.str());
+      return leeway::kExitOk;
+    }
+
+    if (*params_cmd) {
+      leeway::Params p;
+      if (!p_file.empty()) leeway::apply_cell_defaults(leeway::Scene::load(p_file, scene_opts), p);
+      std::cout << leeway::to_json(p).dump(2) << "\n";
+      return leeway::kExitOk;
     }
   } catch (const InputError& e) {
     std::cerr << "leeway: error: " << e.what() << "\n";

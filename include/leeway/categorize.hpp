@@ -7,6 +7,9 @@
 #include <vector>
 
 #include "leeway/box.hpp"
+#include "leeway/params.hpp"
+#include "leeway/scene.hpp"
+#include "leeway/volume.hpp"
 
 namespace leeway {
 
@@ -16,5 +19,17 @@ namespace leeway {
 //! @throws InputError when dz is not a finite positive length or the point is not finite.
 std::optional<size_t> find_goal_obstacle(const Eigen::Vector3d& goal, const std::vector<Box>& obstacles,
                                          double dz);
+
+//! The poses the trail is made of: every waypoint, plus `densify` evenly spaced joint-space poses
+//! inside each segment between consecutive waypoints.
+std::vector<Eigen::VectorXd> trail_poses(const std::vector<Eigen::VectorXd>& path, int densify);
+
+//! Section 3.1 on a scene and a nominal path: the goal obstacle is found by Algorithm 1 below the
+//! tool position at the path's last waypoint; every other obstacle is non-goal (collidable planes
+//! are left out); the trail holds every robot link box at every trail pose; the arm base is the
+//! first hinge joint's anchor, projected on the floor, at every trail pose.
+//! @throws InputError on an empty path, a waypoint of the wrong size or a bad goal_dz.
+Categories categorize(const Scene& scene, const std::vector<Eigen::VectorXd>& path,
+                      const CategorizeParams& params);
 
 }  // namespace leeway

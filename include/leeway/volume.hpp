@@ -15,6 +15,7 @@ namespace leeway {
 //! The categorised obstacles of section 3.1, as boxes in world coordinates.
 struct Categories {
   std::optional<Box> goal;                //!< the goal obstacle (Algorithm 1), if any
+  int goal_geom = -1;                     //!< its geom id in the scene (-1 when none or not from a scene)
   std::vector<Box> non_goal;              //!< every other obstacle
   std::vector<Box> trail;                 //!< robot link boxes at every (densified) path pose
   std::vector<Eigen::Vector2d> arm_base;  //!< arm-base position in the floor plane at every path pose

@@ -1,0 +1,62 @@
+#pragma once
+//! @file bounds.hpp
+//! Jointspace exploration (thesis section 3.3): Algorithm 2 (bisection of one joint's bound against
+//! the volume) and Algorithm 3 (the joint hierarchy), with the collapse guard and the fixed
+//! intervals of the wrist joints and the linear axis.
+
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "leeway/params.hpp"
+#include "leeway/scene.hpp"
+#include "leeway/volume_world.hpp"
+
+namespace leeway {
+
+//! A collision predicate over configurations.
+using CollisionFn = std::function<bool(const Eigen::VectorXd&)>;
+
+//! Algorithm 2: the upper bound of joint j around q (the other joints stay as in q). Checks the
+//! joint at its absolute limit first; if that collides, bisects between q[j] and the limit until
+//! the bracket is at most `delta` wide and returns the highest collision-free value found (q[j]
+//! itself when every probe collides). `checks` is incremented per collision check.
+double bound_upper(const CollisionFn& collides, Eigen::VectorXd q, int j, double limit, double delta,
+                   long& checks);
+
+//! The symmetric lower-bound version of Algorithm 2.
+double bound_lower(const CollisionFn& collides, Eigen::VectorXd q, int j, double limit, double delta,
+                   long& checks);
+
+//! How a joint's interval was obtained.
+enum class BoundKind {
+  kBisected,  //!< Algorithms 2 and 3 (the first three hinge joints)
+  kFixed,     //!< a fixed half-width around nominal (further hinge joints: the wrist)
+  kLinear,    //!< a fraction of the range around nominal (slide joints: the linear axis)
+};
+
+//! The bounds of one waypoint.
+struct WaypointBounds {
+  Eigen::VectorXd q;               //!< nominal configuration
+  Eigen::VectorXd lower;           //!< lower bound per joint [rad or m]
+  Eigen::VectorXd upper;           //!< upper bound per joint [rad or m]
+  std::vector<bool> collapsed;     //!< the collapse guard widened this joint's interval
+  bool nominal_in_volume = false;  //!< the nominal configuration itself touches the volume
+  long checks = 0;                 //!< collision checks spent on this waypoint
+};
+
+//! Algorithm 3 at one waypoint, using `collides` for the volume checks. Bounds always contain the
+//! nominal value and stay within the joint limits.
+WaypointBounds bound_waypoint(const Scene& scene, const CollisionFn& collides, const Eigen::VectorXd& q,
+                              const BoundsParams& params);
+
+//! The kind of every joint, in order.
+std::vector<BoundKind> bound_kinds(const Scene& scene);
+
+//! Bounds of every waypoint against the volume in `world`, spread over `threads` threads (one
+//! VolumeChecker each). Deterministic: the result does not depend on the thread count.
+std::vector<WaypointBounds> bound_path(const VolumeModel& world, const std::vector<Eigen::VectorXd>& path,
+                                       const BoundsParams& params, int threads);
+
+}  // namespace leeway

@@ -1,0 +1,56 @@
+#pragma once
+//! @file pipeline.hpp
+//! The whole method on one path: categorise, generate the volume, inject it, bound every waypoint;
+//! the bounds file format; atomic output files.
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "leeway/bounds.hpp"
+#include "leeway/confidence.hpp"
+#include "leeway/params.hpp"
+#include "leeway/scene.hpp"
+#include "leeway/volume.hpp"
+#include "leeway/volume_world.hpp"
+
+namespace leeway {
+
+//! Cell-specific defaults read from MJCF custom numerics (docs/mjcf-conventions.md):
+//! `leeway_reach_radius` [m] and `leeway_add_obstacle_boxes` (0 or 1). Applied to `params`.
+//! @throws InputError on a non-finite or out-of-range value.
+void apply_cell_defaults(const Scene& scene, Params& params);
+
+//! A path between two keyframes: `waypoints` >= 2 configurations joined linearly in joint space
+//! (the thesis's paths are its two end points). @throws InputError on unknown names or waypoints < 2.
+std::vector<Eigen::VectorXd> keyframe_path(const Scene& scene, const std::string& from, const std::string& to,
+                                           int waypoints);
+
+//! Everything one run produces, with the time of each stage [ms].
+struct BoundsRun {
+  Categories categories;
+  Volume volume;
+  std::vector<WaypointBounds> bounds;
+  long checks = 0;
+  double ms_categorize = 0, ms_volume = 0, ms_inject = 0, ms_bounds = 0;
+  double ms_total() const { return ms_categorize + ms_volume + ms_inject + ms_bounds; }
+};
+
+//! Runs the method on a path against a prepared VolumeModel (its one-off set-up is not timed).
+//! @throws InputError on invalid parameters or waypoints.
+BoundsRun compute_bounds(const Scene& scene, VolumeModel& world, const std::vector<Eigen::VectorXd>& path,
+                         const Params& params, int threads);
+
+//! The bounds file (docs/cli.md): joints, waypoints (q, lower, upper), boxes, max_cells, timing_ms...
+nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Params& params);
+
+//! Reads a bounds file written for `scene`. @throws InputError naming the file and the mismatch
+//! (other joints, wrong sizes, NaN, lower > upper, nominal outside its bounds).
+std::vector<WaypointBounds> read_bounds(const std::string& path, const Scene& scene);
+
+//! Writes text to a temporary file beside `path`, then renames it: no partial file on failure.
+//! @throws InputError naming the file when it cannot be written.
+void write_file_atomic(const std::string& path, const std::string& text);
+
+}  // namespace leeway

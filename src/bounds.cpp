@@ -1,0 +1,163 @@
+#include "leeway/bounds.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <thread>
+
+#include "leeway/error.hpp"
+
+namespace leeway {
+
+double bound_upper(const CollisionFn& collides, Eigen::VectorXd q, int j, double limit, double delta,
+                   long& checks) {
+  // Algorithm 2, lines 1-22: A = highest collision-free value, C = lowest colliding one, B = probe.
+  double a = q[j];
+  double b = limit;
+  double c = b;
+  q[j] = b;
+  ++checks;
+  if (!collides(q)) return b;
+  b = (a + c) / 2;
+  q[j] = b;
+  double range = b - a;
+  while (range > delta) {
+    ++checks;
+    if (collides(q)) {
+      c = b;
+    } else {
+      a = b;
+    }
+    b = (a + c) / 2;
+    q[j] = b;
+    range = b - a;
+  }
+  return a;
+}
+
+double bound_lower(const CollisionFn& collides, Eigen::VectorXd q, int j, double limit, double delta,
+                   long& checks) {
+  // The mirror image of Algorithm 2: A is the lowest collision-free value, C the highest colliding.
+  double a = q[j];
+  double b = limit;
+  double c = b;
+  q[j] = b;
+  ++checks;
+  if (!collides(q)) return b;
+  b = (a + c) / 2;
+  q[j] = b;
+  double range = a - b;
+  while (range > delta) {
+    ++checks;
+    if (collides(q)) {
+      c = b;
+    } else {
+      a = b;
+    }
+    b = (a + c) / 2;
+    q[j] = b;
+    range = a - b;
+  }
+  return a;
+}
+
+std::vector<BoundKind> bound_kinds(const Scene& scene) {
+  std::vector<BoundKind> kinds;
+  int hinges = 0;
+  for (const auto& j : scene.joints()) {
+    if (j.prismatic)
+      kinds.push_back(BoundKind::kLinear);
+    else
+      kinds.push_back(hinges++ < 3 ? BoundKind::kBisected : BoundKind::kFixed);
+  }
+  return kinds;
+}
+
+WaypointBounds bound_waypoint(const Scene& scene, const CollisionFn& collides, const Eigen::VectorXd& q,
+                              const BoundsParams& params) {
+  scene.validate_configuration(q, "waypoint");
+  const int n = scene.dof();
+  const Eigen::VectorXd lo = scene.lower_limits(), hi = scene.upper_limits();
+  for (int i = 0; i < n; ++i)
+    if (q[i] < lo[i] || q[i] > hi[i])
+      throw InputError("waypoint joint '" + scene.joints()[static_cast<size_t>(i)].name +
+                       "' = " + format_number(q[i]) + " is outside its limits");
+  WaypointBounds w;
+  w.q = q;
+  w.lower = q;
+  w.upper = q;
+  w.collapsed.assign(static_cast<size_t>(n), false);
+  const auto kinds = bound_kinds(scene);
+  std::vector<int> bisected;
+  for (int i = 0; i < n; ++i) {
+    const auto& joint = scene.joints()[static_cast<size_t>(i)];
+    if (kinds[static_cast<size_t>(i)] == BoundKind::kBisected) {
+      bisected.push_back(i);
+    } else {
+      // The thesis leaves the wrist arbitrary (section 3.3) and gives the linear axis a fixed
+      // tolerance (section 4.2.3); both are fixed here, clamped to the limits.
+      const double half = kinds[static_cast<size_t>(i)] == BoundKind::kFixed
+                              ? params.wrist_half_width
+                              : params.linear_axis_tolerance * (joint.upper - joint.lower);
+      w.lower[i] = std::max(lo[i], q[i] - half);
+      w.upper[i] = std::min(hi[i], q[i] + half);
+    }
+  }
+  ++w.checks;
+  w.nominal_in_volume = collides(q);
+
+  // Algorithm 3: j1 at nominal; j2 with j1 at each of its bounds; j3 with every combination of
+  // j1's and j2's bounds. The most restrictive result is kept (highest lower, lowest upper).
+  std::vector<Eigen::VectorXd> bases = {q};
+  for (int j : bisected) {
+    double lower = lo[j], upper = hi[j];
+    for (const Eigen::VectorXd& base : bases) {
+      lower = std::max(lower, bound_lower(collides, base, j, lo[j], params.resolution, w.checks));
+      upper = std::min(upper, bound_upper(collides, base, j, hi[j], params.resolution, w.checks));
+    }
+    // Collapse guard (section 3.3): an interval shrunk to the nominal value gets a small one.
+    if (upper - lower < params.resolution) {
+      lower = std::max(lo[j], q[j] - params.min_half_width);
+      upper = std::min(hi[j], q[j] + params.min_half_width);
+      w.collapsed[static_cast<size_t>(j)] = true;
+    }
+    w.lower[j] = lower;
+    w.upper[j] = upper;
+    std::vector<Eigen::VectorXd> next;
+    for (const Eigen::VectorXd& base : bases)
+      for (double v : {lower, upper}) {
+        Eigen::VectorXd b = base;
+        b[j] = v;
+        next.push_back(b);
+      }
+    bases = std::move(next);
+  }
+  return w;
+}
+
+std::vector<WaypointBounds> bound_path(const VolumeModel& world, const std::vector<Eigen::VectorXd>& path,
+                                       const BoundsParams& params, int threads) {
+  const Scene& scene = world.scene();
+  std::vector<WaypointBounds> out(path.size());
+  const int workers = std::max(1, std::min<int>(threads, static_cast<int>(path.size())));
+  std::atomic<size_t> next{0};
+  std::vector<std::exception_ptr> errors(static_cast<size_t>(workers));
+  auto work = [&](int worker) {
+    try {
+      VolumeChecker checker(world);
+      const CollisionFn collides = [&checker](const Eigen::VectorXd& q) { return checker.in_collision(q); };
+      for (size_t i = next++; i < path.size(); i = next++)
+        out[i] = bound_waypoint(scene, collides, path[i], params);
+    } catch (...) {
+      errors[static_cast<size_t>(worker)] = std::current_exception();
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < workers; ++t) pool.emplace_back(work, t);
+  work(0);
+  for (auto& t : pool) t.join();
+  for (auto& e : errors)
+    if (e) std::rethrow_exception(e);
+  return out;
+}
+
+}  // namespace leeway

@@ -1,0 +1,109 @@
+#include "leeway/confidence.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <random>
+#include <thread>
+
+#include "leeway/error.hpp"
+#include "leeway/kinematics.hpp"
+
+namespace leeway {
+namespace {
+
+// SplitMix64: decorrelates the per-window seeds.
+std::uint64_t splitmix(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15ULL;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
+  return x ^ (x >> 31);
+}
+
+double unit(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+
+}  // namespace
+
+std::pair<double, double> wilson_interval(long successes, long n) {
+  if (n <= 0) return {0.0, 1.0};
+  const double z = 1.959963984540054;
+  const double p = static_cast<double>(successes) / static_cast<double>(n);
+  const double nn = static_cast<double>(n);
+  const double denom = 1 + z * z / nn;
+  const double centre = (p + z * z / (2 * nn)) / denom;
+  const double half = z * std::sqrt(p * (1 - p) / nn + z * z / (4 * nn * nn)) / denom;
+  return {std::max(0.0, centre - half), std::min(1.0, centre + half)};
+}
+
+CfResult confidence_factor(const Scene& scene, const std::vector<WaypointBounds>& bounds,
+                           const CfParams& params, int threads) {
+  if (params.windows < 1) throw InputError("CF windows " + std::to_string(params.windows) + " must be >= 1");
+  if (params.samples < 1) throw InputError("CF samples " + std::to_string(params.samples) + " must be >= 1");
+  if (bounds.empty()) throw InputError("CF needs at least one bounded waypoint");
+  for (size_t i = 0; i < bounds.size(); ++i) {
+    const auto& b = bounds[i];
+    if (b.q.size() != scene.dof() || b.lower.size() != scene.dof() || b.upper.size() != scene.dof())
+      throw InputError("bounds of waypoint " + std::to_string(i) + " have the wrong number of joints for " +
+                       scene.source());
+    if (!b.lower.allFinite() || !b.upper.allFinite() || (b.lower.array() > b.upper.array()).any())
+      throw InputError("bounds of waypoint " + std::to_string(i) + " are not finite or have lower > upper");
+  }
+  const int segments = std::max<int>(1, static_cast<int>(bounds.size()) - 1);
+  std::vector<long> free_count(static_cast<size_t>(params.windows), 0);
+  std::atomic<int> next{0};
+  std::vector<std::exception_ptr> errors(static_cast<size_t>(std::max(1, threads)));
+  auto work = [&](int worker) {
+    try {
+      RobotState state(scene);
+      Eigen::VectorXd q(scene.dof());
+      for (int w = next++; w < params.windows; w = next++) {
+        std::mt19937_64 rng(splitmix(params.seed ^ splitmix(static_cast<std::uint64_t>(w))));
+        long ok = 0;
+        for (int k = 0; k < params.samples; ++k) {
+          // Path parameter s in window w, then the segment and the position in it.
+          const double s = (w + unit(rng)) * segments / params.windows;
+          const int seg = std::min(segments - 1, static_cast<int>(s));
+          const double t = bounds.size() == 1 ? 0.0 : s - seg;
+          const WaypointBounds& a = bounds[static_cast<size_t>(seg)];
+          const WaypointBounds& b = bounds[std::min(bounds.size() - 1, static_cast<size_t>(seg) + 1)];
+          for (int i = 0; i < scene.dof(); ++i) {
+            const double lo = a.lower[i] + t * (b.lower[i] - a.lower[i]);
+            const double hi = a.upper[i] + t * (b.upper[i] - a.upper[i]);
+            q[i] = lo + (hi - lo) * unit(rng);
+          }
+          ok += state.in_collision(q) ? 0 : 1;
+        }
+        free_count[static_cast<size_t>(w)] = ok;
+      }
+    } catch (...) {
+      errors[static_cast<size_t>(worker)] = std::current_exception();
+    }
+  };
+  const int workers = std::max(1, std::min(threads, params.windows));
+  std::vector<std::thread> pool;
+  for (int t = 1; t < workers; ++t) pool.emplace_back(work, t);
+  work(0);
+  for (auto& t : pool) t.join();
+  for (auto& e : errors)
+    if (e) std::rethrow_exception(e);
+
+  CfResult r;
+  long total_free = 0;
+  r.worst_window_cf = 2;
+  for (int w = 0; w < params.windows; ++w) {
+    const double share = static_cast<double>(free_count[static_cast<size_t>(w)]) / params.samples;
+    r.window_cf.push_back(share);
+    total_free += free_count[static_cast<size_t>(w)];
+    if (share < r.worst_window_cf) {
+      r.worst_window_cf = share;
+      r.worst_window = w;
+    }
+  }
+  r.samples = static_cast<long>(params.windows) * params.samples;
+  r.collisions = r.samples - total_free;
+  r.cf = static_cast<double>(total_free) / static_cast<double>(r.samples);
+  std::tie(r.ci_low, r.ci_high) = wilson_interval(total_free, r.samples);
+  return r;
+}
+
+}  // namespace leeway

@@ -1,0 +1,201 @@
+#include "leeway/pipeline.hpp"
+
+#include <unistd.h>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "leeway/categorize.hpp"
+#include "leeway/error.hpp"
+
+namespace leeway {
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+nlohmann::json vec(const Eigen::VectorXd& v) {
+  nlohmann::json a = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v[i]);
+  return a;
+}
+
+}  // namespace
+
+void apply_cell_defaults(const Scene& scene, Params& params) {
+  const mjModel& m = scene.model();
+  auto numeric = [&](const char* name, double& out) {
+    const int id = mj_name2id(&m, mjOBJ_NUMERIC, name);
+    if (id < 0) return false;
+    if (m.numeric_size[id] < 1 || !std::isfinite(m.numeric_data[m.numeric_adr[id]]))
+      throw InputError(scene.source() + ": custom numeric '" + name + "' must hold one finite number");
+    out = m.numeric_data[m.numeric_adr[id]];
+    return true;
+  };
+  double v = 0;
+  if (numeric("leeway_reach_radius", v)) {
+    if (v <= 0)
+      throw InputError(scene.source() + ": custom numeric 'leeway_reach_radius' = " + format_number(v) +
+                       " must be > 0 m");
+    params.volume.reach_radius = v;
+  }
+  if (numeric("leeway_add_obstacle_boxes", v)) {
+    if (v != 0 && v != 1)
+      throw InputError(scene.source() + ": custom numeric 'leeway_add_obstacle_boxes' = " + format_number(v) +
+                       " must be 0 or 1");
+    params.volume.add_obstacle_boxes = v == 1;
+  }
+}
+
+std::vector<Eigen::VectorXd> keyframe_path(const Scene& scene, const std::string& from, const std::string& to,
+                                           int waypoints) {
+  if (waypoints < 2) throw InputError("--waypoints " + std::to_string(waypoints) + " must be >= 2");
+  const Eigen::VectorXd a = scene.keyframe(from).q, b = scene.keyframe(to).q;
+  std::vector<Eigen::VectorXd> path;
+  for (int i = 0; i < waypoints; ++i)
+    path.push_back(a + (b - a) * (static_cast<double>(i) / (waypoints - 1)));
+  return path;
+}
+
+BoundsRun compute_bounds(const Scene& scene, VolumeModel& world, const std::vector<Eigen::VectorXd>& path,
+                         const Params& params, int threads) {
+  params.validate();
+  BoundsRun run;
+  auto t = std::chrono::steady_clock::now();
+  run.categories = categorize(scene, path, params.categorize);
+  run.ms_categorize = ms_since(t);
+  t = std::chrono::steady_clock::now();
+  run.volume = generate_volume(run.categories, params.height_map, params.volume);
+  run.ms_volume = ms_since(t);
+  t = std::chrono::steady_clock::now();
+  world.set_boxes(run.volume.boxes);
+  run.ms_inject = ms_since(t);
+  t = std::chrono::steady_clock::now();
+  run.bounds = bound_path(world, path, params.bounds, threads);
+  run.ms_bounds = ms_since(t);
+  for (const auto& b : run.bounds) run.checks += b.checks;
+  return run;
+}
+
+nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Params& params) {
+  using nlohmann::json;
+  json out;
+  out["format"] = "leeway-bounds-1";
+  out["units"] = "SI: metres, radians, milliseconds";
+  out["cell"] = scene.source();
+  out["joints"] = scene.joint_names();
+  json kinds = json::array();
+  for (BoundKind k : bound_kinds(scene))
+    kinds.push_back(k == BoundKind::kBisected ? "bisected"
+                    : k == BoundKind::kFixed  ? "fixed"
+                                              : "linear_axis");
+  out["joint_bounding"] = kinds;
+  json wps = json::array();
+  for (const auto& w : run.bounds) {
+    json collapsed = json::array();
+    for (size_t i = 0; i < w.collapsed.size(); ++i)
+      if (w.collapsed[i]) collapsed.push_back(scene.joints()[i].name);
+    wps.push_back({{"q", vec(w.q)},
+                   {"lower", vec(w.lower)},
+                   {"upper", vec(w.upper)},
+                   {"collapsed", collapsed},
+                   {"nominal_in_volume", w.nominal_in_volume},
+                   {"checks", w.checks}});
+  }
+  out["waypoints"] = wps;
+  out["boxes"] = run.volume.boxes.size();
+  out["max_cells"] = params.height_map.max_cells;
+  out["grid"] = {{"origin", {run.volume.grid.origin_x, run.volume.grid.origin_y}},
+                 {"side", run.volume.grid.side},
+                 {"rows", run.volume.grid.rows},
+                 {"cols", run.volume.grid.cols},
+                 {"cells_under_trail", run.volume.cells_under_trail},
+                 {"cells_out_of_reach", run.volume.cells_out_of_reach}};
+  out["goal_obstacle"] =
+      run.categories.goal_geom >= 0 ? json(scene.geom_label(run.categories.goal_geom)) : json(nullptr);
+  out["trail_boxes"] = run.categories.trail.size();
+  out["collision_checks"] = run.checks;
+  out["timing_ms"] = {{"categorize", run.ms_categorize},
+                      {"volume", run.ms_volume},
+                      {"inject", run.ms_inject},
+                      {"bounds", run.ms_bounds},
+                      {"total", run.ms_total()}};
+  out["params"] = to_json(params);
+  return out;
+}
+
+std::vector<WaypointBounds> read_bounds(const std::string& path, const Scene& scene) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open the bounds file");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path + ": malformed JSON: " + e.what());
+  }
+  auto fail = [&](const std::string& what) { throw InputError(path + ": " + what); };
+  try {
+    if (!j.is_object() || !j.contains("joints") || !j.contains("waypoints"))
+      fail("not a leeway bounds file (needs 'joints' and 'waypoints')");
+    const auto names = j.at("joints").get<std::vector<std::string>>();
+    if (names != scene.joint_names()) {
+      std::string listed;
+      for (const auto& n : names) listed += (listed.empty() ? "" : " ") + n;
+      fail("its joints '" + listed + "' do not match the robot in " + scene.source());
+    }
+    std::vector<WaypointBounds> out;
+    const auto& wps = j.at("waypoints");
+    if (!wps.is_array() || wps.empty()) fail("'waypoints' must be a non-empty list");
+    for (size_t i = 0; i < wps.size(); ++i) {
+      WaypointBounds w;
+      const std::string where = "waypoint " + std::to_string(i);
+      for (const char* key : {"q", "lower", "upper"}) {
+        const auto values = wps[i].at(key).get<std::vector<double>>();
+        if (static_cast<int>(values.size()) != scene.dof())
+          fail(where + " '" + key + "' has " + std::to_string(values.size()) + " values, the robot has " +
+               std::to_string(scene.dof()) + " joints");
+        Eigen::VectorXd v = Eigen::Map<const Eigen::VectorXd>(values.data(), scene.dof());
+        if (std::string(key) == "q") w.q = v;
+        if (std::string(key) == "lower") w.lower = v;
+        if (std::string(key) == "upper") w.upper = v;
+      }
+      for (int k = 0; k < scene.dof(); ++k)
+        if (!(w.lower[k] <= w.q[k] && w.q[k] <= w.upper[k]))
+          fail(where + " joint '" + names[static_cast<size_t>(k)] + "': nominal " + format_number(w.q[k]) +
+               " is not within [" + format_number(w.lower[k]) + ", " + format_number(w.upper[k]) + "]");
+      w.collapsed.assign(static_cast<size_t>(scene.dof()), false);
+      out.push_back(std::move(w));
+    }
+    return out;
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path + ": unexpected content: " + e.what());
+  }
+}
+
+void write_file_atomic(const std::string& path, const std::string& text) {
+  const std::filesystem::path target(path);
+  const std::filesystem::path tmp =
+      target.parent_path() / ("." + target.filename().string() + ".tmp" + std::to_string(::getpid()));
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw InputError(path + ": cannot write the output file (folder missing or not writable)");
+    out << text;
+    out.flush();
+    if (!out) {
+      std::error_code ec;
+      std::filesystem::remove(tmp, ec);
+      throw InputError(path + ": writing the output file failed");
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, target, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw InputError(path + ": cannot move the output file into place");
+  }
+}
+
+}  // namespace leeway

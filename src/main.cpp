@@ -55,14 +55,12 @@ Eigen::VectorXd configuration(const leeway::Scene& scene, const std::string& q, 
 
 std::string joint_unit(const leeway::RobotJoint& j) { return j.prismatic ? "m" : "rad"; }
 
-// Parameters: defaults, then the cell's own (MJCF custom numerics), then a --params file, then flags.
+// Parameters: defaults, then the cell's own (MJCF custom numerics), then the keys present in a
+// --params file, then flags.
 leeway::Params load_params(const leeway::Scene& scene, const std::string& file) {
   leeway::Params p;
-  if (file.empty()) {
-    leeway::apply_cell_defaults(scene, p);
-  } else {
-    p = leeway::read_params(file);
-  }
+  leeway::apply_cell_defaults(scene, p);
+  if (!file.empty()) p = leeway::read_params(file, p);
   return p;
 }
 

@@ -38,6 +38,7 @@ void for_each_field(P& p, F&& f) {
   f("volume", "alpha_ng", p.volume.alpha_ng);
   f("volume", "goal_constant_term", p.volume.goal_constant_term);
   f("volume", "reach_radius", p.volume.reach_radius);
+  f("volume", "trail_margin", p.volume.trail_margin);
   f("volume", "add_obstacle_boxes", p.volume.add_obstacle_boxes);
   f("volume", "distance", p.volume.distance);
   f("categorize", "goal_dz", p.categorize.goal_dz);
@@ -160,6 +161,7 @@ void Params::validate() const {
   require_smaller("volume.d_g_lb", v.d_g_lb, "volume.d_g_ub", v.d_g_ub);
   require_positive("volume.d_ng_ub", v.d_ng_ub);
   require_positive("volume.h_max", v.h_max);
+  require_non_negative("volume.trail_margin", v.trail_margin);
   require_positive("volume.alpha_t", v.alpha_t);
   require_positive("volume.alpha_g", v.alpha_g);
   require_positive("volume.alpha_ng", v.alpha_ng);
@@ -188,8 +190,8 @@ nlohmann::json to_json(const Params& p) {
   return j;
 }
 
-Params params_from_json(const nlohmann::json& j, const std::string& source) {
-  Params p;
+Params params_from_json(const nlohmann::json& j, const std::string& source, const Params& base) {
+  Params p = base;
   if (!j.is_object())
     throw InputError(source + ": the parameters must be a JSON object, got " + j.type_name() + " " +
                      shown(j));
@@ -229,7 +231,7 @@ Params params_from_json(const nlohmann::json& j, const std::string& source) {
   return p;
 }
 
-Params read_params(const std::string& path) {
+Params read_params(const std::string& path, const Params& base) {
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open the parameter file");
   json j;
@@ -241,7 +243,7 @@ Params read_params(const std::string& path) {
       if (ch == '\n' || ch == '\r') ch = ' ';
     throw InputError(path + ": malformed JSON: " + message);
   }
-  return params_from_json(j, path);
+  return params_from_json(j, path, base);
 }
 
 }  // namespace leeway

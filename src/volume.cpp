@@ -430,7 +430,9 @@ Volume generate_volume(const Categories& c, const HeightMapParams& hm, const Vol
   // whose squares meet the trail box's footprint rectangle (one cell of margin) are tested.
   const double max_height = 3.0 * v.h_max;
   std::vector<unsigned char> under_trail(rows * cols, 0);
-  for (const Box& t : c.trail) {
+  for (Box t : c.trail) {
+    // trail_margin (0 in the thesis): the trail box grown by the margin on every side.
+    t.half_size.array() += v.trail_margin;
     Eigen::AlignedBox3d box;
     for (const Vector3d& corner : corners(t)) box.extend(corner);
     if (box.min().z() > max_height || box.max().z() < 0) continue;

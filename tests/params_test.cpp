@@ -132,7 +132,7 @@ TEST(ParamsJsonTest, KeysAreTheFieldNames) {
   EXPECT_EQ(j.at("cf").at("seed"), 18446744073709551615ull);
   EXPECT_EQ(j.size(), 5u);
   EXPECT_EQ(j.at("height_map").size(), 6u);
-  EXPECT_EQ(j.at("volume").size(), 13u);
+  EXPECT_EQ(j.at("volume").size(), 14u);  // 13 of section 4.1 and 3.2 plus trail_margin
   EXPECT_EQ(j.at("categorize").size(), 2u);
   EXPECT_EQ(j.at("bounds").size(), 4u);
   EXPECT_EQ(j.at("cf").size(), 3u);
@@ -298,6 +298,25 @@ TEST(ReadParamsTest, InvalidValueInFileNamesFileAndKey) {
   const std::string path = dir.write("p.json", R"({"volume": {"d_g_lb": 2.5}})");
   const std::string m = error_of([&] { read_params(path); });
   EXPECT_EQ(m, path + ": parameter 'volume.d_g_lb' = 2.5 must be smaller than 'volume.d_g_ub' = 2");
+}
+
+}  // namespace
+}  // namespace leeway
+
+namespace leeway {
+namespace {
+
+TEST(ParamsLayeringTest, KeysInTheFileOverrideTheBaseOthersKeepIt) {
+  // A cell's defaults (DLR: reach 3.0 m, obstacle boxes) survive a file that sets only the margin.
+  Params base;
+  base.volume.reach_radius = 3.0;
+  base.volume.add_obstacle_boxes = true;
+  const Params p =
+      params_from_json(nlohmann::json::parse(R"({"volume": {"trail_margin": 0.1}})"), "p.json", base);
+  EXPECT_EQ(p.volume.reach_radius, 3.0);
+  EXPECT_TRUE(p.volume.add_obstacle_boxes);
+  EXPECT_EQ(p.volume.trail_margin, 0.1);
+  EXPECT_EQ(p.volume.d_t_lb, 0.35);  // untouched default
 }
 
 }  // namespace

@@ -341,6 +341,24 @@ TEST(VolumeTest, TrailTestUsesThreeTimesHmax) {
   EXPECT_EQ(vol.boxes.size(), 16u);
 }
 
+TEST(VolumeTest, TrailMarginWidensTheClearedCells) {
+  // The trail box of TrailTestUsesThreeTimesHmax, lowered to z in [0.75, 1.25]: x in [1, 2],
+  // y in [0, 1] touches cells i in {0, 1, 2}, j in {0, 1} (6 cells). Grown by 0.3 m it spans
+  // x in [0.7, 2.3], y in [-0.3, 1.3]: still inside the squares of those 6 cells. Grown by 1 m it
+  // spans x in [0, 3], y in [-1, 2]: it touches i = 3 (face x = 3) and j = 2 (face y = 2) too,
+  // 4 x 3 = 12 cells. A margin of 0 is the thesis's test.
+  Categories c;
+  c.arm_base = {{0.5, 0.5}};
+  VolumeParams v;
+  v.reach_radius = 10.0;
+  c.trail = {box({1.5, 0.5, 1.0}, {0.5, 0.5, 0.25})};
+  EXPECT_EQ(generate_volume(c, explicit_map(0, 0, 4, 4, 16), v).cells_under_trail, 6);
+  v.trail_margin = 0.3;
+  EXPECT_EQ(generate_volume(c, explicit_map(0, 0, 4, 4, 16), v).cells_under_trail, 6);
+  v.trail_margin = 1.0;
+  EXPECT_EQ(generate_volume(c, explicit_map(0, 0, 4, 4, 16), v).cells_under_trail, 12);
+}
+
 TEST(VolumeTest, ReachFromEveryBasePosition) {
   // A base moving from (0.5, 0.5) to (3.5, 0.5), reach 1 m: within 1 m of either position are the
   // cells (0,0) (0,1) (1,0) [distances 0, 1, 1] and (3,0) (3,1) (2,0); (1,1) is sqrt(2) away.

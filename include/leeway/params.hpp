@@ -30,17 +30,21 @@ struct HeightMapParams {
 
 //! The height function, eq. 3.1 with the goal term of eq. 4.1, and the activation A_t.
 struct VolumeParams {
-  double d_t_lb = 0.35;             //!< trail term lower bound [m]
-  double d_t_ub = 1.50;             //!< trail term upper bound [m]
-  double d_g_lb = 0.10;             //!< goal term lower bound [m]
-  double d_g_ub = 2.00;             //!< goal term upper bound [m]
-  double d_ng_ub = 0.50;            //!< non-goal obstacle term upper bound [m]
-  double h_max = 1.50;              //!< largest contribution of one term [m]
-  double alpha_t = 1.0;             //!< exponent of the trail term
-  double alpha_g = 1.0;             //!< exponent of the goal term
-  double alpha_ng = 1.0;            //!< exponent of the non-goal term
-  bool goal_constant_term = true;   //!< eq. 4.1: h_max/3 + 2/3 h_max (...)^alpha_g instead of eq. 3.1's term
-  double reach_radius = 2.8;        //!< A_t = 0 beyond this distance from the arm's base [m] (DLR: 3.0)
+  double d_t_lb = 0.35;            //!< trail term lower bound [m]
+  double d_t_ub = 1.50;            //!< trail term upper bound [m]
+  double d_g_lb = 0.10;            //!< goal term lower bound [m]
+  double d_g_ub = 2.00;            //!< goal term upper bound [m]
+  double d_ng_ub = 0.50;           //!< non-goal obstacle term upper bound [m]
+  double h_max = 1.50;             //!< largest contribution of one term [m]
+  double alpha_t = 1.0;            //!< exponent of the trail term
+  double alpha_g = 1.0;            //!< exponent of the goal term
+  double alpha_ng = 1.0;           //!< exponent of the non-goal term
+  bool goal_constant_term = true;  //!< eq. 4.1: h_max/3 + 2/3 h_max (...)^alpha_g instead of eq. 3.1's term
+  double reach_radius = 2.8;       //!< A_t = 0 beyond this distance from the arm's base [m] (DLR: 3.0)
+  //! A_t = 0 also where the max-height box comes within this distance of a trail box (the trail
+  //! box grown by it on every side) [m]. 0 is section 4.1's test, "right below the trail"; a
+  //! positive value reads section 3.2.2's "too close to the trail" as a clearance (docs/algorithm.md).
+  double trail_margin = 0.0;
   bool add_obstacle_boxes = false;  //!< DLR option: the obstacles' own boxes join the volume
   DistanceMode distance = DistanceMode::kPlane;
 };
@@ -84,8 +88,9 @@ struct Params {
 nlohmann::json to_json(const Params& p);
 //! Parameters from JSON: missing keys keep their defaults, unknown keys are an error.
 //! @throws InputError naming `source`, the key and the value.
-Params params_from_json(const nlohmann::json& j, const std::string& source);
+//! Keys present in `j` override `base` (the defaults unless given).
+Params params_from_json(const nlohmann::json& j, const std::string& source, const Params& base = Params{});
 //! Reads and validates a parameter file. @throws InputError naming the file.
-Params read_params(const std::string& path);
+Params read_params(const std::string& path, const Params& base = Params{});
 
 }  // namespace leeway

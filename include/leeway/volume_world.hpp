@@ -31,7 +31,10 @@ class VolumeModel {
   //! pool when it is too small. Not thread-safe: call it before checkers run.
   void set_boxes(const std::vector<Box>& boxes);
 
+  //! The model; its ngeom counts only the active pool geoms (see set_boxes()).
   const mjModel& model() const { return *model_; }
+  //! An mjData sized for the whole pool (use this, not mj_makeData on model()).
+  DataPtr make_data() const;
   const Scene& scene() const { return *scene_; }
   int capacity() const { return capacity_; }
   int active() const { return active_; }

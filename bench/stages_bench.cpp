@@ -67,13 +67,14 @@ int main(int argc, char** argv) {
     std::vector<int> cells;
     for (const double c : leeway::parse_vector(cells_list, "--cells")) cells.push_back(static_cast<int>(c));
 
-    double t0 = now_ms();
+    const double t0 = now_ms();
     leeway::VolumeModel world(scene, *std::max_element(cells.begin(), cells.end()) + 16);
     const double setup_ms = now_ms() - t0;
 
     std::printf("# %s %s -> %s, %d repeat(s), %d thread(s), trail_margin %.3f m; medians\n", cell.c_str(),
                 from.c_str(), to.c_str(), repeats, threads, margin);
-    std::printf("# one-off set-up (load + volume pool of %d geoms): %.1f ms\n\n", world.capacity(), setup_ms);
+    std::printf("# one-off set-up (compile the cell with its volume pool, grown to %d geoms): %.1f ms\n\n",
+                world.capacity(), setup_ms);
     std::printf(
         "| MAX_cells | boxes | checks | categorize ms | volume ms | inject ms | bounds ms | total ms |"
         " us/check | kinematics us | mj_collision us |\n");

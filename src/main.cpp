@@ -71,7 +71,10 @@ std::vector<int> parse_cells_list(const std::string& text) {
   const Eigen::VectorXd v = leeway::parse_vector(text, "--max-cells");
   for (Eigen::Index i = 0; i < v.size(); ++i) {
     if (v[i] != std::floor(v[i]) || v[i] < 1 || v[i] > 1e6)
-      throw InputError("--max-cells value '" + leeway::format_number(v[i]) +
+      throw InputError("--max-cells value '" +
+                       (std::abs(v[i]) < 1e15 && v[i] == std::floor(v[i])
+                            ? std::to_string(static_cast<long long>(v[i]))
+                            : leeway::format_number(v[i])) +
                        "' must be a whole number from 1 to 1000000");
     out.push_back(static_cast<int>(v[i]));
   }
@@ -321,7 +324,7 @@ int main(int argc, char** argv) {
     if (*bounds) {
       const auto scene = leeway::Scene::load(b_file, scene_opts);
       leeway::Params p = load_params(scene, b_params);
-      if (b_cells != 0) p.height_map.max_cells = b_cells;
+      if (bounds->count("--max-cells") > 0) p.height_map.max_cells = b_cells;
       p.validate();
       if (b_threads < 1) throw InputError("--threads " + std::to_string(b_threads) + " must be >= 1");
       const auto path = leeway::keyframe_path(scene, b_from, b_to, b_waypoints);
@@ -383,6 +386,10 @@ int main(int argc, char** argv) {
     if (*sweep) {
       const auto scene = leeway::Scene::load(s_file, scene_opts);
       const leeway::Params base = load_params(scene, s_params);
+      // CF settings: the parameter file's cf section unless given on the command line.
+      if (sweep->count("--windows") == 0) s_cf.windows = base.cf.windows;
+      if (sweep->count("--samples") == 0) s_cf.samples = base.cf.samples;
+      if (sweep->count("--seed") == 0) s_cf.seed = base.cf.seed;
       const std::vector<int> cells = parse_cells_list(s_cells);
       if (s_threads < 1) throw InputError("--threads " + std::to_string(s_threads) + " must be >= 1");
       const auto path = leeway::keyframe_path(scene, s_from, s_to, s_waypoints);
@@ -394,21 +401,37 @@ int main(int argc, char** argv) {
       leeway::VolumeModel world(scene, *std::max_element(cells.begin(), cells.end()) +
                                            static_cast<int>(scene.obstacle_geoms().size()));
       std::ostringstream md, csv;
-      md << "| Max CBox | CBox | Computational Time [ms] | Confidence Factor [%] | 95 % CI [%] | worst "
-            "window [%] |\n"
-         << "|---:|---:|---:|---:|---|---:|\n";
-      csv << "max_cells,boxes,time_ms,volume_ms,bounds_ms,checks,cf,ci_low,ci_high,worst_window_cf\n";
+      md << "| Max CBox | CBox | Computational Time [ms] | Confidence Factor [%] | 95 % CI [%] |"
+            " worst window [%] | collapsed | mean width j1-j3 [rad] |\n"
+         << "|---:|---:|---:|---:|---|---:|---:|---:|\n";
+      csv << "max_cells,boxes,time_ms,volume_ms,bounds_ms,checks,cf,ci_low,ci_high,worst_window_cf,collapsed,"
+             "mean_width\n";
+      const auto kinds = leeway::bound_kinds(scene);
       for (int c : cells) {
         leeway::Params p = base;
         p.height_map.max_cells = c;
         const auto run = leeway::compute_bounds(scene, world, path, p, s_threads);
         const auto r = leeway::confidence_factor(scene, run.bounds, s_cf, s_threads);
+        // Collapsed intervals and the mean width of the bisected joints' intervals.
+        int collapsed = 0, bisected = 0;
+        double width = 0;
+        for (const auto& w : run.bounds)
+          for (size_t i = 0; i < kinds.size(); ++i)
+            if (kinds[i] == leeway::BoundKind::kBisected) {
+              const auto k = static_cast<Eigen::Index>(i);
+              collapsed += w.collapsed[i] ? 1 : 0;
+              width += w.upper[k] - w.lower[k];
+              ++bisected;
+            }
+        width /= std::max(1, bisected);
         md << std::fixed << "| " << c << " | " << run.volume.boxes.size() << " | " << std::setprecision(1)
            << run.ms_total() << " | " << std::setprecision(4) << 100 * r.cf << " | " << 100 * r.ci_low
-           << " .. " << 100 * r.ci_high << " | " << 100 * r.worst_window_cf << " |\n";
+           << " .. " << 100 * r.ci_high << " | " << 100 * r.worst_window_cf << " | " << collapsed << "/"
+           << bisected << " | " << std::setprecision(3) << width << " |\n";
         csv << c << "," << run.volume.boxes.size() << "," << std::setprecision(3) << run.ms_total() << ","
             << run.ms_volume << "," << run.ms_bounds << "," << run.checks << "," << std::setprecision(6)
-            << r.cf << "," << r.ci_low << "," << r.ci_high << "," << r.worst_window_cf << "\n";
+            << r.cf << "," << r.ci_low << "," << r.ci_high << "," << r.worst_window_cf << "," << collapsed
+            << "," << width << "\n";
         std::cerr << "max_cells " << c << " done\n";
       }
       std::cout << md.str();

@@ -162,6 +162,13 @@ std::vector<WaypointBounds> read_bounds(const std::string& path, const Scene& sc
         if (std::string(key) == "lower") w.lower = v;
         if (std::string(key) == "upper") w.upper = v;
       }
+      for (int k = 0; k < scene.dof(); ++k) {
+        const auto& joint = scene.joints()[static_cast<size_t>(k)];
+        if (!(w.lower[k] >= joint.lower && w.upper[k] <= joint.upper))
+          fail(where + " joint '" + joint.name + "': bounds [" + format_number(w.lower[k]) + ", " +
+               format_number(w.upper[k]) + "] leave its limits [" + format_number(joint.lower) + ", " +
+               format_number(joint.upper) + "]");
+      }
       for (int k = 0; k < scene.dof(); ++k)
         if (!(w.lower[k] <= w.q[k] && w.q[k] <= w.upper[k]))
           fail(where + " joint '" + names[static_cast<size_t>(k)] + "': nominal " + format_number(w.q[k]) +

@@ -255,10 +255,7 @@ DataPtr VolumeModel::make_data() const {
 }
 
 VolumeChecker::VolumeChecker(const VolumeModel& world)
-    : world_(&world),
-      robot_(world.scene()),
-      data_(world.make_data()),
-      data_capacity_(world.capacity()) {
+    : world_(&world), robot_(world.scene()), data_(world.make_data()), data_capacity_(world.capacity()) {
   const Scene& scene = world.scene();
   const mjModel& small = scene.model();
   for (int b = 1; b < small.nbody; ++b)

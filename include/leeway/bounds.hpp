@@ -19,9 +19,11 @@ namespace leeway {
 using CollisionFn = std::function<bool(const Eigen::VectorXd&)>;
 
 //! Algorithm 2: the upper bound of joint j around q (the other joints stay as in q). Checks the
-//! joint at its absolute limit first; if that collides, bisects between q[j] and the limit until
-//! the bracket is at most `delta` wide and returns the highest collision-free value found (q[j]
-//! itself when every probe collides). `checks` is incremented per collision check.
+//! joint at its absolute limit first and returns it when free (an obstacle met only in the middle
+//! of the sweep is then not seen, as in the thesis); otherwise bisects between q[j] and the limit
+//! while the probe B is more than `delta` above the highest collision-free value A (the thesis's
+//! loop condition: the final bracket [A, C] can be up to 2 delta wide), and returns A (q[j] itself
+//! when every probe collides). `checks` is incremented per collision check.
 double bound_upper(const CollisionFn& collides, Eigen::VectorXd q, int j, double limit, double delta,
                    long& checks);
 

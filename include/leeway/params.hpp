@@ -1,7 +1,8 @@
 #pragma once
 //! @file params.hpp
 //! Every parameter of the joint-boundary algorithm in one plain struct, with JSON I/O.
-//! Defaults are the thesis's (section 4.1) converted to SI units. docs/algorithm.md documents each.
+//! The height function's defaults are the thesis's (section 4.1) in SI units; the others are
+//! leeway's choices. docs/algorithm.md documents each and where it comes from.
 
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -57,10 +58,12 @@ struct CategorizeParams {
 
 //! Bounding (section 3.3).
 struct BoundsParams {
-  double resolution = 0.01;  //!< Algorithm 2's Δ [rad, or m for slide joints]
-  //! collapse guard: an interval narrower than this on a side is widened to it [rad or m]
+  double resolution = 0.01;  //!< Algorithm 2's Δ [rad] (only hinge joints are bisected)
+  //! Collapse guard (section 3.3): a bisected joint whose interval came out narrower than
+  //! `resolution` (lower = upper = nominal) gets nominal +- this, clamped to its limits [rad or m]
   double min_half_width = 0.01;
-  double wrist_half_width = 0.2;        //!< fixed half-width of joints 4-6 around nominal [rad]
+  //! fixed half-width around nominal of every hinge joint after the third (the wrist) [rad]
+  double wrist_half_width = 0.2;
   double linear_axis_tolerance = 0.03;  //!< slide joints: half-width as a fraction of the joint's range
 };
 

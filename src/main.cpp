@@ -8,11 +8,13 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
+#include <tuple>
 
 #include "leeway/check.hpp"
 #include "leeway/error.hpp"
 #include "leeway/kinematics.hpp"
 #include "leeway/pipeline.hpp"
+#include "leeway/planner.hpp"
 #include "leeway/scene.hpp"
 
 namespace {
@@ -82,6 +84,38 @@ std::vector<int> parse_cells_list(const std::string& text) {
   return out;
 }
 
+// A path end that needs inverse kinematics (and so a planned path) rather than a keyframe.
+bool is_gripper_goal(const std::string& spec) {
+  return spec.rfind("site:", 0) == 0 || spec.rfind("xyz:", 0) == 0;
+}
+
+// Plans between two path ends (docs/planning.md). On an unreachable goal or no path, prints the
+// one-line reason and returns false: the caller exits with kExitFindings and writes nothing.
+bool plan_between(const leeway::Scene& scene, const std::string& from, const std::string& to,
+                  const std::string& ik_seed_key, const leeway::PlanOptions& options,
+                  leeway::PlanResult& result, leeway::Endpoint& a, leeway::Endpoint& b) {
+  leeway::EndpointOptions eo;
+  eo.ik_seed_key = ik_seed_key;
+  std::tie(a, b) = leeway::resolve_endpoints(scene, from, to, eo);
+  for (const leeway::Endpoint* e : {&a, &b}) {
+    if (e->reachable) continue;
+    std::cerr << "leeway: unreachable: " << scene.source() << ": " << (e == &a ? "start" : "goal") << " '"
+              << e->spec << "' at (" << leeway::format_number(e->position.x()) << ", "
+              << leeway::format_number(e->position.y()) << ", " << leeway::format_number(e->position.z())
+              << ") m: no collision-free configuration with the tool pointing down within the joint limits"
+              << " (closest: position error " << leeway::format_number(e->ik.position_error)
+              << " m, orientation error " << leeway::format_number(e->ik.orientation_error)
+              << "); nothing written\n";
+    return false;
+  }
+  result = leeway::plan_path(scene, a.q, b.q, options, "start '" + from + "'", "goal '" + to + "'");
+  if (!result.success) {
+    std::cerr << "leeway: no path: " << scene.source() << ": " << result.message << "; nothing written\n";
+    return false;
+  }
+  return true;
+}
+
 // The thesis's 20 MAX_cells values (section 4.1).
 const char* kThesisCells =
     "100,150,200,500,750,1000,1500,2000,3000,5000,7500,10000,12000,15000,20000,25000,30000,40000,50000,"
@@ -146,18 +180,61 @@ int main(int argc, char** argv) {
   ik->add_flag("--json", ik_json, "Print JSON");
   add_tool(ik);
 
+  // plan
+  std::string pl_file, pl_from, pl_to, pl_out, pl_ik_seed;
+  bool pl_json = false, pl_no_simplify = false, pl_no_direct = false;
+  leeway::PlanOptions pl_opts;
+  CLI::App* plan = app.add_subcommand(
+      "plan",
+      "Plan a collision-free path (OMPL RRT-Connect in joint space, then simplified) between two\n"
+      "keyframes or gripper goals (site:NAME, xyz:X,Y,Z: inverse kinematics first); see docs/planning.md.\n"
+      "Exit 0 path found, 1 unreachable goal or no path within the time limit, 2 bad input\n"
+      "(also a start or goal in collision).");
+  plan->add_option("cell", pl_file, "MJCF file of the workcell")->required();
+  plan->add_option("--from", pl_from, "Start: a keyframe, site:NAME or xyz:X,Y,Z [m]")->required();
+  plan->add_option("--to", pl_to, "Goal: a keyframe, site:NAME or xyz:X,Y,Z [m]")->required();
+  plan->add_option("--seed", pl_opts.seed, "Random seed (same seed, same path)")->capture_default_str();
+  plan->add_option("--time-limit", pl_opts.time_limit, "RRT-Connect's time budget [s]")
+      ->capture_default_str();
+  plan->add_option("--resolution", pl_opts.resolution, "Motion resolution of hinge joints [rad]")
+      ->capture_default_str();
+  plan->add_option("--slide-resolution", pl_opts.slide_resolution, "Motion resolution of slide joints [m]")
+      ->capture_default_str();
+  plan->add_option("--range", pl_opts.range, "RRT-Connect's longest extension [rad]; 0 = OMPL's default")
+      ->capture_default_str();
+  plan->add_option("--clearance", pl_opts.clearance, "Clearance margin to the obstacles [m]")
+      ->capture_default_str();
+  plan->add_flag("--no-simplify", pl_no_simplify, "Keep RRT-Connect's raw path");
+  plan->add_flag("--no-direct", pl_no_direct,
+                 "Run RRT-Connect even when the joint-linear edge from start to goal is free");
+  plan->add_option("--ik-seed", pl_ik_seed, "Keyframe seeding the inverse kinematics of gripper goals");
+  plan->add_option("--out", pl_out, "Write the path file here (JSON)");
+  plan->add_flag("--json", pl_json, "Print the path file to standard output");
+  add_tool(plan);
+
   // bounds
-  std::string b_file, b_from, b_to, b_params, b_out;
+  std::string b_file, b_from, b_to, b_params, b_out, b_path, b_ik_seed;
   int b_cells = 0, b_waypoints = 2, b_threads = default_threads();
   bool b_json = false;
+  leeway::PlanOptions b_plan;
   CLI::App* bounds = app.add_subcommand(
-      "bounds", "Joint bounds along the path between two keyframes (thesis chapter 3). Exit 0 on success.");
+      "bounds",
+      "Joint bounds along a path (thesis chapter 3): the joint-linear path between two keyframes, a\n"
+      "planned path when --from/--to name a gripper goal (site:NAME, xyz:X,Y,Z), or every waypoint of\n"
+      "a path file (--path). Exit 0 on success, 1 unreachable goal or no path, 2 bad input.");
   bounds->add_option("cell", b_file, "MJCF file of the workcell")->required();
-  bounds->add_option("--from", b_from, "Keyframe the path starts at")->required();
-  bounds->add_option("--to", b_to, "Keyframe the path ends at")->required();
+  auto* b_path_opt =
+      bounds->add_option("--path", b_path, "Path file written by leeway plan --out (instead of --from/--to)");
+  bounds->add_option("--from", b_from, "Start: a keyframe, site:NAME or xyz:X,Y,Z")->excludes(b_path_opt);
+  bounds->add_option("--to", b_to, "Goal: a keyframe, site:NAME or xyz:X,Y,Z")->excludes(b_path_opt);
   bounds
-      ->add_option("--waypoints", b_waypoints, "Waypoints along the joint-linear path (>= 2; the thesis: 2)")
+      ->add_option("--waypoints", b_waypoints,
+                   "Waypoints along the joint-linear path between two keyframes (>= 2; the thesis: 2)")
       ->capture_default_str();
+  bounds->add_option("--seed", b_plan.seed, "Planner seed (gripper goals)")->capture_default_str();
+  bounds->add_option("--time-limit", b_plan.time_limit, "Planner time budget [s] (gripper goals)")
+      ->capture_default_str();
+  bounds->add_option("--ik-seed", b_ik_seed, "Keyframe seeding the inverse kinematics of gripper goals");
   bounds->add_option("--max-cells", b_cells, "MAX_cells of the height-map (default: from --params, 20000)");
   bounds->add_option("--params", b_params, "Parameter file (JSON; see leeway params)");
   bounds->add_option("--out", b_out, "Write the bounds file here (JSON)");
@@ -208,9 +285,9 @@ int main(int argc, char** argv) {
     // CLI11 would only say "A subcommand is required" for a mistyped one: name it.
     const std::string first = argc > 1 ? argv[1] : "";
     if (!first.empty() && first[0] != '-' && first != "check" && first != "fk" && first != "ik" &&
-        first != "bounds" && first != "cf" && first != "sweep" && first != "params") {
+        first != "plan" && first != "bounds" && first != "cf" && first != "sweep" && first != "params") {
       std::cerr << "leeway: error: unknown subcommand '" << first
-                << "'; subcommands: check, fk, ik, bounds, cf, sweep, params "
+                << "'; subcommands: check, fk, ik, plan, bounds, cf, sweep, params "
                 << "(see leeway --help)\n";
       return leeway::kExitBadInput;
     }
@@ -321,13 +398,68 @@ int main(int argc, char** argv) {
       }
       return result.success ? leeway::kExitOk : leeway::kExitFindings;
     }
+    if (*plan) {
+      const auto scene = leeway::Scene::load(pl_file, scene_opts);
+      pl_opts.simplify = !pl_no_simplify;
+      pl_opts.try_direct = !pl_no_direct;
+      leeway::PlanResult result;
+      leeway::Endpoint a, b;
+      if (!plan_between(scene, pl_from, pl_to, pl_ik_seed, pl_opts, result, a, b))
+        return leeway::kExitFindings;
+      const json out = leeway::path_json(scene, result, pl_opts, a, b);
+      if (!pl_out.empty()) leeway::write_file_atomic(pl_out, out.dump(2) + "\n");
+      if (pl_json) {
+        std::cout << out.dump(2) << "\n";
+      } else {
+        std::cout << scene.source() << " " << pl_from << " -> " << pl_to << " (units: rad, m, s)\n";
+        std::cout << result.waypoints.size() << " waypoints, " << result.method
+                  << (result.method == "direct" ? " (the joint-linear edge is free)" : "") << ", length "
+                  << leeway::format_number(result.length) << " rad (weighted), " << result.checks
+                  << " collision checks, "
+                  << leeway::format_number(result.plan_seconds + result.simplify_seconds) << " s, seed "
+                  << pl_opts.seed << "\n";
+        std::cout << "joints:";
+        for (const auto& n : scene.joint_names()) std::cout << " " << n;
+        std::cout << "\n" << std::fixed << std::setprecision(6);
+        for (size_t w = 0; w < result.waypoints.size(); ++w) {
+          std::cout << "  " << std::setw(3) << w << ":";
+          for (Eigen::Index i = 0; i < result.waypoints[w].size(); ++i)
+            std::cout << " " << result.waypoints[w][i];
+          std::cout << "\n";
+        }
+        if (!pl_out.empty()) std::cout << "wrote " << pl_out << "\n";
+      }
+      return leeway::kExitOk;
+    }
+
     if (*bounds) {
       const auto scene = leeway::Scene::load(b_file, scene_opts);
       leeway::Params p = load_params(scene, b_params);
       if (bounds->count("--max-cells") > 0) p.height_map.max_cells = b_cells;
       p.validate();
       if (b_threads < 1) throw InputError("--threads " + std::to_string(b_threads) + " must be >= 1");
-      const auto path = leeway::keyframe_path(scene, b_from, b_to, b_waypoints);
+      std::vector<Eigen::VectorXd> path;
+      std::string label = b_from + " -> " + b_to;
+      const bool linear = b_path.empty() && !is_gripper_goal(b_from) && !is_gripper_goal(b_to);
+      if (!linear && bounds->count("--waypoints") > 0)
+        throw InputError("--waypoints applies to the joint-linear path between two keyframes only, not to " +
+                         std::string(b_path.empty() ? "a planned path" : "--path"));
+      if (!b_path.empty()) {
+        path = leeway::read_path(b_path, scene);
+        label = b_path;
+      } else if (b_from.empty() || b_to.empty()) {
+        throw InputError(b_file +
+                         ": give the path with --from and --to (keyframes, site:NAME or xyz:X,Y,Z)"
+                         " or with --path FILE");
+      } else if (linear) {
+        path = leeway::keyframe_path(scene, b_from, b_to, b_waypoints);
+      } else {
+        leeway::PlanResult planned;
+        leeway::Endpoint a, b;
+        if (!plan_between(scene, b_from, b_to, b_ik_seed, b_plan, planned, a, b))
+          return leeway::kExitFindings;
+        path = planned.waypoints;
+      }
       leeway::VolumeModel world(scene,
                                 p.height_map.max_cells + static_cast<int>(scene.obstacle_geoms().size()));
       const auto run = leeway::compute_bounds(scene, world, path, p, b_threads);
@@ -336,7 +468,7 @@ int main(int argc, char** argv) {
       if (b_json) {
         std::cout << out.dump(2) << "\n";
       } else {
-        std::cout << scene.source() << " " << b_from << " -> " << b_to << " (units: rad, m, ms)\n";
+        std::cout << scene.source() << " " << label << " (units: rad, m, ms)\n";
         std::cout << "MAX_cells " << p.height_map.max_cells << ", boxes " << run.volume.boxes.size()
                   << ", goal obstacle " << out["goal_obstacle"].dump() << ", collision checks " << run.checks
                   << "\n";

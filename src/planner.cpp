@@ -1,0 +1,664 @@
+#include "leeway/planner.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <fstream>
+#include <memory>
+#include <mutex>
+
+#include <ompl/base/MotionValidator.h>
+#include <ompl/base/ProblemDefinition.h>
+#include <ompl/base/ScopedState.h>
+#include <ompl/base/SpaceInformation.h>
+#include <ompl/base/StateValidityChecker.h>
+#include <ompl/base/spaces/RealVectorStateSpace.h>
+#include <ompl/config.h>
+#include <ompl/geometric/PathGeometric.h>
+#include <ompl/geometric/PathSimplifier.h>
+#include <ompl/geometric/planners/rrt/RRTConnect.h>
+#include <ompl/util/Console.h>
+
+#include "leeway/box.hpp"
+#include "leeway/error.hpp"
+
+namespace leeway {
+namespace {
+
+namespace ob = ompl::base;
+namespace og = ompl::geometric;
+using nlohmann::json;
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+json vec(const Eigen::VectorXd& v) {
+  json a = json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v[i]);
+  return a;
+}
+
+// SplitMix64: independent, well-mixed 32-bit seeds for the planner's random streams from one
+// user seed (OMPL's RNG takes 32 bits; 0 is avoided, OMPL rejects it as a global seed).
+std::uint32_t stream_seed(std::uint64_t seed, std::uint64_t stream) {
+  std::uint64_t z = seed + 0x9e3779b97f4a7c15ULL * (stream + 1);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  z ^= z >> 31;
+  const auto s = static_cast<std::uint32_t>(z >> 32);
+  return s == 0 ? 1u : s;
+}
+
+// The step of every joint: `resolution` for hinges, `slide_resolution` for slides.
+Eigen::VectorXd joint_steps(const Scene& scene, double resolution, double slide_resolution) {
+  Eigen::VectorXd step(scene.dof());
+  for (int i = 0; i < scene.dof(); ++i)
+    step[i] = scene.joints()[static_cast<size_t>(i)].prismatic ? slide_resolution : resolution;
+  return step;
+}
+
+// Segments of the edge a -> b such that no joint moves more than its step between samples (the
+// 1e-9 keeps 3 / 0.01 = 300.00000000000006 at 300 segments).
+long edge_segments(const Eigen::VectorXd& a, const Eigen::VectorXd& b, const Eigen::VectorXd& step) {
+  const double m = ((b - a).cwiseAbs().array() / step.array()).maxCoeff();
+  return std::max(1L, static_cast<long>(std::ceil(m - 1e-9)));
+}
+
+Eigen::VectorXd lerp(const Eigen::VectorXd& a, const Eigen::VectorXd& b, long k, long n) {
+  if (k == n) return b;
+  return a + (b - a) * (static_cast<double>(k) / static_cast<double>(n));
+}
+
+// RobotState::clearance(q).distance >= margin at the configuration last set, but quicker: most
+// link-obstacle pairs are ruled out by two lower bounds of their distance (bounding spheres, then
+// the separating-axis gap) before the exact, iterative box distance is needed.
+bool keeps_clearance(const RobotState& state, double margin) {
+  const Scene& scene = state.scene();
+  const mjModel& m = scene.model();
+  const mjData& d = state.data();
+  for (int o : scene.obstacle_geoms()) {
+    if (m.geom_type[o] == mjGEOM_PLANE) continue;  // as RobotState::clearance
+    const Box ob = geom_box(m, d, o);
+    for (int l : scene.link_geoms()) {
+      const Box lb = geom_box(m, d, l);
+      if ((lb.center - ob.center).norm() - lb.half_size.norm() - ob.half_size.norm() >= margin) continue;
+      if (-box_penetration(lb, ob) >= margin) continue;
+      if (box_distance(lb, ob) < margin) return false;
+    }
+  }
+  return true;
+}
+
+// A configuration is free when it is within the limits, touches no obstacle and, with a margin,
+// keeps at least that clearance.
+bool configuration_free(RobotState& state, const Eigen::VectorXd& q, double clearance) {
+  if (!state.scene().joints_outside_limits(q).empty()) return false;
+  if (state.in_collision(q)) return false;  // also sets the kinematics for keeps_clearance
+  return clearance <= 0 || keeps_clearance(state, clearance);
+}
+
+// RobotStates for the threads that check configurations: one mjData per concurrent caller.
+class StatePool {
+ public:
+  explicit StatePool(const Scene& scene) : scene_(&scene) {}
+
+  //! A RobotState borrowed for one check; returned to the pool when the lease dies.
+  class Lease {
+   public:
+    Lease(StatePool& pool, std::unique_ptr<RobotState> s) : pool_(&pool), state_(std::move(s)) {}
+    ~Lease() { pool_->give_back(std::move(state_)); }
+    Lease(const Lease&) = delete;
+    Lease& operator=(const Lease&) = delete;
+    RobotState& operator*() const { return *state_; }
+
+   private:
+    StatePool* pool_;
+    std::unique_ptr<RobotState> state_;
+  };
+
+  Lease lease() {
+    std::unique_ptr<RobotState> s;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!free_.empty()) {
+        s = std::move(free_.back());
+        free_.pop_back();
+      }
+    }
+    if (!s) s = std::make_unique<RobotState>(*scene_);
+    return Lease(*this, std::move(s));
+  }
+
+ private:
+  void give_back(std::unique_ptr<RobotState> s) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    free_.push_back(std::move(s));
+  }
+  const Scene* scene_;
+  std::mutex mutex_;
+  std::vector<std::unique_ptr<RobotState>> free_;
+};
+
+// Everything OMPL's callbacks need: the conversion between OMPL's coordinates and joint values,
+// and the collision checks. OMPL plans in joint values divided by their step (resolution or
+// slide_resolution), so that its Euclidean metric weighs one metre of a slide like
+// resolution / slide_resolution radians of a hinge, and one unit is one collision-check step.
+class Checker {
+ public:
+  Checker(const Scene& scene, Eigen::VectorXd step, double clearance)
+      : scene_(&scene),
+        step_(std::move(step)),
+        lower_(scene.lower_limits()),
+        upper_(scene.upper_limits()),
+        clearance_(clearance),
+        pool_(scene) {}
+
+  Eigen::VectorXd to_q(const ob::State* s) const {
+    const double* x = s->as<ob::RealVectorStateSpace::StateType>()->values;
+    Eigen::VectorXd q(scene_->dof());
+    // Clamped: x * step can leave the limits by an ulp.
+    for (int i = 0; i < scene_->dof(); ++i) q[i] = std::clamp(x[i] * step_[i], lower_[i], upper_[i]);
+    return q;
+  }
+  void to_state(const Eigen::VectorXd& q, ob::State* s) const {
+    double* x = s->as<ob::RealVectorStateSpace::StateType>()->values;
+    for (int i = 0; i < scene_->dof(); ++i) x[i] = q[i] / step_[i];
+  }
+
+  bool free(const Eigen::VectorXd& q) {
+    ++checks_;
+    auto state = pool_.lease();
+    return configuration_free(*state, q, clearance_);
+  }
+
+  // The edge a -> b at the resolution, `a` assumed free (OMPL's convention). The far end first,
+  // then the samples in bisection order: a blocked edge is usually found after few checks.
+  bool edge_free(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+    const long n = edge_segments(a, b, step_);
+    if (!free(b)) return false;
+    std::deque<std::pair<long, long>> intervals{{0, n}};
+    while (!intervals.empty()) {
+      const auto [lo, hi] = intervals.front();
+      intervals.pop_front();
+      if (hi - lo < 2) continue;
+      const long mid = lo + (hi - lo) / 2;
+      if (!free(lerp(a, b, mid, n))) return false;
+      intervals.emplace_back(lo, mid);
+      intervals.emplace_back(mid, hi);
+    }
+    return true;
+  }
+
+  // The edge a -> b in order from a; on failure the last free sample and its fraction of the edge.
+  bool edge_free_from(const Eigen::VectorXd& a, const Eigen::VectorXd& b, long& last_free, long& segments) {
+    segments = edge_segments(a, b, step_);
+    for (long k = 1; k <= segments; ++k)
+      if (!free(lerp(a, b, k, segments))) {
+        last_free = k - 1;
+        return false;
+      }
+    return true;
+  }
+
+  long checks() const { return checks_.load(); }
+  const Eigen::VectorXd& step() const { return step_; }
+
+ private:
+  const Scene* scene_;
+  Eigen::VectorXd step_, lower_, upper_;
+  double clearance_;
+  StatePool pool_;
+  std::atomic<long> checks_{0};
+};
+
+class ValidityChecker : public ob::StateValidityChecker {
+ public:
+  ValidityChecker(const ob::SpaceInformationPtr& si, std::shared_ptr<Checker> checker)
+      : ob::StateValidityChecker(si), checker_(std::move(checker)) {}
+  bool isValid(const ob::State* s) const override { return checker_->free(checker_->to_q(s)); }
+
+ private:
+  std::shared_ptr<Checker> checker_;
+};
+
+// Replaces OMPL's DiscreteMotionValidator (whose resolution is a fraction of the space's diagonal,
+// in the Euclidean metric) by leeway's per-joint criterion, so that the planner, the simplifier and
+// edge_is_free() agree on what a free edge is.
+class MotionValidator : public ob::MotionValidator {
+ public:
+  MotionValidator(const ob::SpaceInformationPtr& si, std::shared_ptr<Checker> checker)
+      : ob::MotionValidator(si), checker_(std::move(checker)) {}
+
+  bool checkMotion(const ob::State* s1, const ob::State* s2) const override {
+    return checker_->edge_free(checker_->to_q(s1), checker_->to_q(s2));
+  }
+
+  bool checkMotion(const ob::State* s1, const ob::State* s2,
+                   std::pair<ob::State*, double>& last_valid) const override {
+    long last = 0, n = 1;
+    if (checker_->edge_free_from(checker_->to_q(s1), checker_->to_q(s2), last, n)) return true;
+    last_valid.second = static_cast<double>(last) / static_cast<double>(n);
+    if (last_valid.first != nullptr)
+      si_->getStateSpace()->interpolate(s1, s2, last_valid.second, last_valid.first);
+    return false;
+  }
+
+ private:
+  std::shared_ptr<Checker> checker_;
+};
+
+// OMPL's RNG instances draw their seeds from one process-wide sequence, and RNG::setSeed() may
+// only be called before the first RNG exists (later calls log an error). Instead, every random
+// stream of a plan gets its own seed from PlanOptions::seed: the state samplers, RRT-Connect's and
+// the simplifier's generators. (The nearest-neighbour structure's random pivots change its speed,
+// not its answers: its queries are exact.)
+class SeededSampler : public ob::RealVectorStateSampler {
+ public:
+  SeededSampler(const ob::StateSpace* space, std::uint32_t seed) : ob::RealVectorStateSampler(space) {
+    rng_.setLocalSeed(seed);
+  }
+};
+
+class SeededRRTConnect : public og::RRTConnect {
+ public:
+  SeededRRTConnect(const ob::SpaceInformationPtr& si, std::uint32_t seed) : og::RRTConnect(si) {
+    rng_.setLocalSeed(seed);
+  }
+};
+
+class SeededSimplifier : public og::PathSimplifier {
+ public:
+  SeededSimplifier(const ob::SpaceInformationPtr& si, std::uint32_t seed) : og::PathSimplifier(si) {
+    rng_.setLocalSeed(seed);
+  }
+};
+
+std::vector<Eigen::VectorXd> to_waypoints(const og::PathGeometric& path, const Checker& checker) {
+  std::vector<Eigen::VectorXd> out;
+  for (unsigned i = 0; i < path.getStateCount(); ++i) out.push_back(checker.to_q(path.getState(i)));
+  return out;
+}
+
+// The whole path at the resolution, each edge from its start.
+bool path_free(Checker& checker, const std::vector<Eigen::VectorXd>& path) {
+  if (path.empty() || !checker.free(path.front())) return false;
+  for (std::size_t i = 1; i < path.size(); ++i)
+    if (!checker.edge_free(path[i - 1], path[i])) return false;
+  return true;
+}
+
+double weighted_length(const std::vector<Eigen::VectorXd>& path, const Eigen::VectorXd& step,
+                       double resolution) {
+  double length = 0;
+  for (std::size_t i = 1; i < path.size(); ++i)
+    length += ((path[i] - path[i - 1]).array() / step.array()).matrix().norm() * resolution;
+  return length;
+}
+
+void validate(const PlanOptions& o) {
+  auto finite_positive = [](double v, const std::string& what, double lo, double hi, const char* unit) {
+    if (!(std::isfinite(v) && v >= lo && v <= hi))
+      throw InputError(what + " " + format_number(v) + " " + unit + " must be a finite number from " +
+                       format_number(lo) + " to " + format_number(hi));
+  };
+  finite_positive(o.time_limit, "--time-limit", 1e-3, 86400, "s");
+  finite_positive(o.resolution, "--resolution", 1e-5, 1.0, "rad");
+  finite_positive(o.slide_resolution, "--slide-resolution", 1e-5, 1.0, "m");
+  if (!(std::isfinite(o.range) && o.range >= 0))
+    throw InputError("--range " + format_number(o.range) +
+                     " rad must be a finite number >= 0 (0: OMPL's default)");
+  if (!(std::isfinite(o.clearance) && o.clearance >= 0 && o.clearance <= 10))
+    throw InputError("--clearance " + format_number(o.clearance) + " m must be a finite number from 0 to 10");
+}
+
+// OMPL logs to the console: keep its warnings and errors, drop its progress messages. Once per
+// process, so that a caller's own level set later wins.
+void quiet_ompl() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    if (ompl::msg::getLogLevel() < ompl::msg::LOG_WARN) ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+  });
+}
+
+json endpoint_json(const Endpoint& e) {
+  json out = {{"spec", e.spec}, {"q", vec(e.q)}};
+  out["keyframe"] = e.keyframe.empty() ? json(nullptr) : json(e.keyframe);
+  out["site"] = e.site.empty() ? json(nullptr) : json(e.site);
+  out["position"] =
+      e.keyframe.empty() ? json({e.position.x(), e.position.y(), e.position.z()}) : json(nullptr);
+  return out;
+}
+
+Eigen::VectorXd default_seed(const Scene& scene) {
+  if (!scene.keyframes().empty()) return scene.keyframes().front().q;
+  return Eigen::VectorXd::Zero(scene.dof()).cwiseMax(scene.lower_limits()).cwiseMin(scene.upper_limits());
+}
+
+}  // namespace
+
+Eigen::VectorXd place_slides(const Scene& scene, const Eigen::Vector3d& goal, const Eigen::VectorXd& q) {
+  scene.validate_configuration(q, "linear-axis policy configuration");
+  if (!goal.allFinite()) throw InputError("linear-axis policy: the goal position is not finite");
+  int base_joint = -1;
+  for (const auto& j : scene.joints())
+    if (!j.prismatic) {
+      base_joint = j.id;
+      break;
+    }
+  RobotState state(scene);
+  Eigen::VectorXd out = q;
+  for (int i = 0; i < scene.dof(); ++i) {
+    const RobotJoint& joint = scene.joints()[static_cast<size_t>(i)];
+    if (!joint.prismatic) continue;
+    out[i] = 0.0;
+    state.set(out);
+    const mjData& d = state.data();
+    const Eigen::Vector3d base =
+        base_joint >= 0 ? Eigen::Vector3d(Eigen::Map<const Eigen::Vector3d>(d.xanchor + 3 * base_joint))
+                        : state.tool_pose().position;
+    const Eigen::Vector3d axis = Eigen::Map<const Eigen::Vector3d>(d.xaxis + 3 * joint.id).normalized();
+    out[i] = std::clamp(axis.dot(goal - base), joint.lower, joint.upper);
+  }
+  return out;
+}
+
+IkResult gripper_ik(RobotState& state, const Eigen::Vector3d& goal, const Eigen::VectorXd& seed,
+                    IkOptions options) {
+  const Scene& scene = state.scene();
+  scene.validate_configuration(seed, "IK seed");
+  if (!goal.allFinite()) throw InputError("IK target position is not finite");
+  options.locked.resize(static_cast<size_t>(scene.dof()), false);
+  for (int i = 0; i < scene.dof(); ++i)
+    if (scene.joints()[static_cast<size_t>(i)].prismatic) options.locked[static_cast<size_t>(i)] = true;
+  return solve_ik(state, goal, place_slides(scene, goal, seed), options);
+}
+
+Eigen::Vector3d site_position(const Scene& scene, const std::string& name) {
+  const int site = scene.goal_site(name);
+  // Goal sites are outside the robot: any configuration gives their position.
+  RobotState state(scene);
+  state.set(default_seed(scene));
+  return state.site_pose(site).position;
+}
+
+std::pair<Endpoint, Endpoint> resolve_endpoints(const Scene& scene, const std::string& from,
+                                                const std::string& to, const EndpointOptions& options) {
+  auto parse = [&](const std::string& spec) {
+    Endpoint e;
+    e.spec = spec;
+    if (spec.rfind("site:", 0) == 0) {
+      e.site = spec.substr(5);
+      if (e.site.empty()) throw InputError(scene.source() + ": '" + spec + "' names no site (site:NAME)");
+      e.position = site_position(scene, e.site);
+    } else if (spec.rfind("xyz:", 0) == 0) {
+      const Eigen::VectorXd v = parse_vector(spec.substr(4), "'" + spec + "'");
+      if (v.size() != 3)
+        throw InputError("'" + spec + "' must give three coordinates x,y,z [m], got " +
+                         std::to_string(v.size()));
+      e.position = v;
+    } else {
+      if (spec.empty())
+        throw InputError(scene.source() + ": an empty path end (give a keyframe or site:NAME)");
+      e.keyframe = spec;
+      e.q = scene.keyframe(spec).q;
+    }
+    return e;
+  };
+  Endpoint a = parse(from), b = parse(to);
+  Eigen::VectorXd fixed_seed;
+  if (!options.ik_seed_key.empty()) fixed_seed = scene.keyframe(options.ik_seed_key).q;
+  RobotState state(scene);
+  auto solve = [&](Endpoint& e, const Eigen::VectorXd& seed) {
+    e.ik = gripper_ik(state, e.position, fixed_seed.size() > 0 ? fixed_seed : seed, options.ik);
+    e.reachable = e.ik.success;
+    e.q = e.ik.q;
+  };
+  if (a.keyframe.empty()) solve(a, b.keyframe.empty() ? default_seed(scene) : b.q);
+  if (b.keyframe.empty()) solve(b, a.q);
+  return {a, b};
+}
+
+void require_free(RobotState& state, const Eigen::VectorXd& q, double clearance, const std::string& what) {
+  const Scene& scene = state.scene();
+  scene.validate_configuration(q, what);
+  for (int i : scene.joints_outside_limits(q)) {
+    const RobotJoint& j = scene.joints()[static_cast<size_t>(i)];
+    const char* unit = j.prismatic ? " m" : " rad";
+    throw InputError(what + ": joint '" + j.name + "' = " + format_number(q[i]) + unit +
+                     " is outside its limits [" + format_number(j.lower) + ", " + format_number(j.upper) +
+                     "]" + unit);
+  }
+  const auto contacts = state.contacts(q);
+  if (!contacts.empty())
+    throw InputError(
+        what + " is in collision: link '" + scene.geom_label(contacts[0].link_geom) +
+        "' penetrates obstacle '" + scene.geom_label(contacts[0].obstacle_geom) + "' by " +
+        format_number(contacts[0].depth) + " m" +
+        (contacts.size() > 1 ? " (and " + std::to_string(contacts.size() - 1) + " more contacts)" : ""));
+  if (clearance > 0) {
+    const Clearance c = state.clearance(q);
+    if (c.distance < clearance)
+      throw InputError(what + " is " + format_number(c.distance) + " m from obstacle '" +
+                       scene.geom_label(c.obstacle_geom) + "' (link '" + scene.geom_label(c.link_geom) +
+                       "'), closer than the clearance margin " + format_number(clearance) + " m");
+  }
+}
+
+bool edge_is_free(RobotState& state, const Eigen::VectorXd& a, const Eigen::VectorXd& b, double resolution,
+                  double slide_resolution, double clearance, long& checks) {
+  const Scene& scene = state.scene();
+  scene.validate_configuration(a, "edge start");
+  scene.validate_configuration(b, "edge end");
+  if (!(resolution > 0 && slide_resolution > 0))
+    throw InputError("edge check: the resolutions must be > 0, got " + format_number(resolution) +
+                     " rad and " + format_number(slide_resolution) + " m");
+  const Eigen::VectorXd step = joint_steps(scene, resolution, slide_resolution);
+  const long n = edge_segments(a, b, step);
+  for (long k = 0; k <= n; ++k) {
+    ++checks;
+    if (!configuration_free(state, lerp(a, b, k, n), clearance)) return false;
+  }
+  return true;
+}
+
+PlanResult plan_path(const Scene& scene, const Eigen::VectorXd& start, const Eigen::VectorXd& goal,
+                     const PlanOptions& options, const std::string& start_name,
+                     const std::string& goal_name) {
+  validate(options);
+  {
+    RobotState state(scene);
+    require_free(state, start, options.clearance, scene.source() + ": " + start_name);
+    require_free(state, goal, options.clearance, scene.source() + ": " + goal_name);
+  }
+  quiet_ompl();
+  const auto t0 = std::chrono::steady_clock::now();
+  const int n = scene.dof();
+  auto checker = std::make_shared<Checker>(
+      scene, joint_steps(scene, options.resolution, options.slide_resolution), options.clearance);
+  PlanResult result;
+
+  // The straight joint-space edge, when free, is the shortest path in the planner's metric: no
+  // sampling needed (the thesis's own nominal paths between keyframes are such edges).
+  if (options.try_direct && checker->edge_free(start, goal)) {
+    result.success = true;
+    result.method = "direct";
+    result.waypoints = {start, goal};
+    result.raw_waypoints = 2;
+    result.plan_seconds = seconds_since(t0);
+    result.length = weighted_length(result.waypoints, checker->step(), options.resolution);
+    result.checks = checker->checks();
+    return result;
+  }
+
+  auto space = std::make_shared<ob::RealVectorStateSpace>(static_cast<unsigned>(n));
+  ob::RealVectorBounds bounds(static_cast<unsigned>(n));
+  for (int i = 0; i < n; ++i) {
+    const RobotJoint& j = scene.joints()[static_cast<size_t>(i)];
+    bounds.setLow(static_cast<unsigned>(i), j.lower / checker->step()[i]);
+    bounds.setHigh(static_cast<unsigned>(i), j.upper / checker->step()[i]);
+  }
+  space->setBounds(bounds);
+  auto samplers = std::make_shared<std::atomic<std::uint64_t>>(0);
+  const std::uint64_t seed = options.seed;
+  space->setStateSamplerAllocator([seed, samplers](const ob::StateSpace* s) -> ob::StateSamplerPtr {
+    return std::make_shared<SeededSampler>(s, stream_seed(seed, 100 + (*samplers)++));
+  });
+  auto si = std::make_shared<ob::SpaceInformation>(space);
+  si->setStateValidityChecker(std::make_shared<ValidityChecker>(si, checker));
+  si->setMotionValidator(std::make_shared<MotionValidator>(si, checker));
+  si->setup();
+
+  ob::ScopedState<> s(space), g(space);
+  checker->to_state(start, s.get());
+  checker->to_state(goal, g.get());
+  auto pdef = std::make_shared<ob::ProblemDefinition>(si);
+  pdef->setStartAndGoalStates(s, g);
+  auto planner = std::make_shared<SeededRRTConnect>(si, stream_seed(seed, 1));
+  if (options.range > 0) planner->setRange(options.range / options.resolution);
+  planner->setProblemDefinition(pdef);
+  planner->setup();
+  const ob::PlannerStatus status = planner->solve(ob::timedPlannerTerminationCondition(options.time_limit));
+  result.method = "rrt_connect";
+  result.plan_seconds = seconds_since(t0);
+  if (status != ob::PlannerStatus::EXACT_SOLUTION) {
+    result.checks = checker->checks();
+    result.message = "no collision-free path from " + start_name + " to " + goal_name +
+                     " found within the time limit of " + format_number(options.time_limit) + " s (seed " +
+                     std::to_string(options.seed) + "); try a longer --time-limit or another --seed" +
+                     (options.clearance > 0 ? std::string(", or a smaller --clearance") : std::string());
+    return result;
+  }
+
+  const auto t1 = std::chrono::steady_clock::now();
+  const og::PathGeometric raw = *std::static_pointer_cast<og::PathGeometric>(pdef->getSolutionPath());
+  result.raw_waypoints = raw.getStateCount();
+  // The exact end configurations: the conversion to OMPL's coordinates and back may move them by
+  // an ulp.
+  auto finish = [&](std::vector<Eigen::VectorXd> w) {
+    if (w.size() < 2) w.resize(2);  // a path is at least its two ends (start == goal)
+    w.front() = start;
+    w.back() = goal;
+    return w;
+  };
+  std::vector<Eigen::VectorXd> waypoints = finish(to_waypoints(raw, *checker));
+  if (options.simplify) {
+    og::PathGeometric simple = raw;
+    SeededSimplifier simplifier(si, stream_seed(seed, 2));
+    // simplifyMax: no time limit, so the result depends on the seed only.
+    simplifier.simplifyMax(simple);
+    // Re-check the simplified path edge by edge with leeway's criterion; OMPL's repair step may
+    // move a state without checking its edges, and then RRT-Connect's checked path is kept.
+    std::vector<Eigen::VectorXd> w = finish(to_waypoints(simple, *checker));
+    if (path_free(*checker, w)) {
+      waypoints = std::move(w);
+      result.simplified = true;
+    }
+  }
+  LEEWAY_DEMAND(result.simplified || path_free(*checker, waypoints));
+  result.simplify_seconds = seconds_since(t1);
+  result.success = true;
+  result.waypoints = std::move(waypoints);
+  result.length = weighted_length(result.waypoints, checker->step(), options.resolution);
+  result.checks = checker->checks();
+  return result;
+}
+
+json path_json(const Scene& scene, const PlanResult& result, const PlanOptions& options, const Endpoint& from,
+               const Endpoint& to) {
+  json out;
+  out["format"] = "leeway-path-1";
+  out["units"] = "SI: metres, radians, seconds";
+  out["cell"] = scene.source();
+  out["joints"] = scene.joint_names();
+  json wps = json::array();
+  for (const auto& q : result.waypoints) wps.push_back({{"q", vec(q)}});
+  out["waypoints"] = wps;
+  out["from"] = endpoint_json(from);
+  out["to"] = endpoint_json(to);
+  out["planner"] = {
+      {"name", "RRTConnect"},
+      {"library", "OMPL " + std::to_string(OMPL_MAJOR_VERSION) + "." + std::to_string(OMPL_MINOR_VERSION) +
+                      "." + std::to_string(OMPL_PATCH_VERSION)},
+      {"method", result.method},
+      {"seed", options.seed},
+      {"time_limit", options.time_limit},
+      {"resolution", options.resolution},
+      {"slide_resolution", options.slide_resolution},
+      {"range", options.range},
+      {"clearance", options.clearance},
+      {"simplify", options.simplify},
+      {"try_direct", options.try_direct}};
+  out["simplified"] = result.simplified;
+  out["raw_waypoints"] = result.raw_waypoints;
+  out["length"] = result.length;
+  out["collision_checks"] = result.checks;
+  out["time"] = {{"plan", result.plan_seconds},
+                 {"simplify", result.simplify_seconds},
+                 {"total", result.plan_seconds + result.simplify_seconds}};
+  return out;
+}
+
+std::vector<Eigen::VectorXd> read_path(const std::string& path, const Scene& scene) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open the path file");
+  json j;
+  try {
+    j = json::parse(in);
+  } catch (const json::exception& e) {
+    throw InputError(path + ": malformed JSON: " + e.what());
+  }
+  auto fail = [&](const std::string& what) { throw InputError(path + ": " + what); };
+  try {
+    if (!j.is_object() || !j.contains("joints") || !j.contains("waypoints"))
+      fail("not a leeway path file (needs 'joints' and 'waypoints')");
+    if (j.contains("format")) {
+      const auto format = j.at("format").get<std::string>();
+      if (format != "leeway-path-1" && format != "leeway-bounds-1")
+        fail("format '" + format + "' is not a leeway path (leeway-path-1) or bounds file (leeway-bounds-1)");
+    }
+    const auto names = j.at("joints").get<std::vector<std::string>>();
+    if (names != scene.joint_names()) {
+      auto list = [](const std::vector<std::string>& v) {
+        std::string s;
+        for (const auto& n : v) s += (s.empty() ? "" : " ") + n;
+        return s;
+      };
+      fail("its joints '" + list(names) + "' do not match the robot in " + scene.source() + " ('" +
+           list(scene.joint_names()) + "')");
+    }
+    const auto& wps = j.at("waypoints");
+    if (!wps.is_array() || wps.size() < 2)
+      fail("'waypoints' must be a list of at least two waypoints, got " +
+           (wps.is_array() ? std::to_string(wps.size()) : std::string("a ") + wps.type_name()));
+    std::vector<Eigen::VectorXd> out;
+    for (size_t i = 0; i < wps.size(); ++i) {
+      const std::string where = "waypoint " + std::to_string(i);
+      if (!wps[i].is_object() || !wps[i].contains("q")) fail(where + " has no 'q'");
+      const auto& values = wps[i].at("q");
+      if (!values.is_array() || static_cast<int>(values.size()) != scene.dof())
+        fail(where + " 'q' has " + (values.is_array() ? std::to_string(values.size()) : std::string("no")) +
+             " values, the robot has " + std::to_string(scene.dof()) + " joints");
+      Eigen::VectorXd q(scene.dof());
+      for (int k = 0; k < scene.dof(); ++k) {
+        const auto& v = values[static_cast<size_t>(k)];
+        const RobotJoint& joint = scene.joints()[static_cast<size_t>(k)];
+        if (!v.is_number() || !std::isfinite(v.get<double>()))
+          fail(where + " joint '" + joint.name + "': " + v.dump() + " is not a finite number");
+        q[k] = v.get<double>();
+        if (q[k] < joint.lower || q[k] > joint.upper)
+          fail(where + " joint '" + joint.name + "' = " + format_number(q[k]) +
+               (joint.prismatic ? " m" : " rad") + " is outside its limits [" + format_number(joint.lower) +
+               ", " + format_number(joint.upper) + "]");
+      }
+      out.push_back(std::move(q));
+    }
+    return out;
+  } catch (const json::exception& e) {
+    throw InputError(path + ": unexpected content: " + e.what());
+  }
+}
+
+}  // namespace leeway

@@ -16,7 +16,7 @@ class InputError : public std::runtime_error {
 //! Exit codes of the `leeway` program; docs/cli.md lists them.
 enum ExitCode : int {
   kExitOk = 0,        //!< success, and (check) no findings
-  kExitFindings = 1,  //!< the input was usable but the check found problems
+  kExitFindings = 1,  //!< usable input, negative outcome: check found problems, no IK solution, no path
   kExitBadInput = 2,  //!< the input cannot be used (missing file, malformed XML, bad value)
   kExitInternal = 3,  //!< a bug in leeway: please report it
 };

@@ -1,16 +1,21 @@
 #include "leeway/bounds.hpp"
 
 #include <algorithm>
-#include <atomic>
-#include <thread>
+#include <cmath>
+#include <memory>
 
 #include "leeway/error.hpp"
+#include "parallel.hpp"
 
 namespace leeway {
 
-double bound_upper(const CollisionFn& collides, Eigen::VectorXd q, int j, double limit, double delta,
-                   long& checks) {
-  // Algorithm 2, lines 1-22: A = highest collision-free value, C = lowest colliding one, B = probe.
+namespace {
+
+// Algorithm 2 in either direction (the limit above or below q[j]): A = the farthest value known
+// collision-free, C = the nearest known colliding one, B = the probe. The loop runs while the probe
+// is more than delta from A, as the thesis's listing has it (lines 10-20).
+double bisect_towards(const CollisionFn& collides, Eigen::VectorXd q, int j, double limit, double delta,
+                      long& checks) {
   double a = q[j];
   double b = limit;
   double c = b;
@@ -19,7 +24,7 @@ double bound_upper(const CollisionFn& collides, Eigen::VectorXd q, int j, double
   if (!collides(q)) return b;
   b = (a + c) / 2;
   q[j] = b;
-  double range = b - a;
+  double range = std::abs(b - a);
   while (range > delta) {
     ++checks;
     if (collides(q)) {
@@ -29,35 +34,21 @@ double bound_upper(const CollisionFn& collides, Eigen::VectorXd q, int j, double
     }
     b = (a + c) / 2;
     q[j] = b;
-    range = b - a;
+    range = std::abs(b - a);
   }
   return a;
 }
 
+}  // namespace
+
+double bound_upper(const CollisionFn& collides, Eigen::VectorXd q, int j, double limit, double delta,
+                   long& checks) {
+  return bisect_towards(collides, std::move(q), j, limit, delta, checks);
+}
+
 double bound_lower(const CollisionFn& collides, Eigen::VectorXd q, int j, double limit, double delta,
                    long& checks) {
-  // The mirror image of Algorithm 2: A is the lowest collision-free value, C the highest colliding.
-  double a = q[j];
-  double b = limit;
-  double c = b;
-  q[j] = b;
-  ++checks;
-  if (!collides(q)) return b;
-  b = (a + c) / 2;
-  q[j] = b;
-  double range = a - b;
-  while (range > delta) {
-    ++checks;
-    if (collides(q)) {
-      c = b;
-    } else {
-      a = b;
-    }
-    b = (a + c) / 2;
-    q[j] = b;
-    range = a - b;
-  }
-  return a;
+  return bisect_towards(collides, std::move(q), j, limit, delta, checks);
 }
 
 std::vector<BoundKind> bound_kinds(const Scene& scene) {
@@ -138,25 +129,14 @@ std::vector<WaypointBounds> bound_path(const VolumeModel& world, const std::vect
                                        const BoundsParams& params, int threads) {
   const Scene& scene = world.scene();
   std::vector<WaypointBounds> out(path.size());
-  const int workers = std::max(1, std::min<int>(threads, static_cast<int>(path.size())));
-  std::atomic<size_t> next{0};
-  std::vector<std::exception_ptr> errors(static_cast<size_t>(workers));
-  auto work = [&](int worker) {
-    try {
-      VolumeChecker checker(world);
-      const CollisionFn collides = [&checker](const Eigen::VectorXd& q) { return checker.in_collision(q); };
-      for (size_t i = next++; i < path.size(); i = next++)
-        out[i] = bound_waypoint(scene, collides, path[i], params);
-    } catch (...) {
-      errors[static_cast<size_t>(worker)] = std::current_exception();
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < workers; ++t) pool.emplace_back(work, t);
-  work(0);
-  for (auto& t : pool) t.join();
-  for (auto& e : errors)
-    if (e) std::rethrow_exception(e);
+  detail::parallel_for(static_cast<int>(path.size()), threads, [&] {
+    // One VolumeChecker (one mjData) per thread.
+    auto checker = std::make_shared<VolumeChecker>(world);
+    return [&, checker](int i) {
+      const CollisionFn collides = [&checker](const Eigen::VectorXd& q) { return checker->in_collision(q); };
+      out[static_cast<size_t>(i)] = bound_waypoint(scene, collides, path[static_cast<size_t>(i)], params);
+    };
+  });
   return out;
 }
 

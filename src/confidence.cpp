@@ -1,13 +1,13 @@
 #include "leeway/confidence.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
+#include <memory>
 #include <random>
-#include <thread>
 
 #include "leeway/error.hpp"
 #include "leeway/kinematics.hpp"
+#include "parallel.hpp"
 
 namespace leeway {
 namespace {
@@ -50,42 +50,30 @@ CfResult confidence_factor(const Scene& scene, const std::vector<WaypointBounds>
   }
   const int segments = std::max<int>(1, static_cast<int>(bounds.size()) - 1);
   std::vector<long> free_count(static_cast<size_t>(params.windows), 0);
-  std::atomic<int> next{0};
-  std::vector<std::exception_ptr> errors(static_cast<size_t>(std::max(1, threads)));
-  auto work = [&](int worker) {
-    try {
-      RobotState state(scene);
+  detail::parallel_for(params.windows, threads, [&] {
+    // One RobotState (one mjData) per thread.
+    auto state = std::make_shared<RobotState>(scene);
+    return [&, state](int w) {
+      std::mt19937_64 rng(splitmix(params.seed ^ splitmix(static_cast<std::uint64_t>(w))));
       Eigen::VectorXd q(scene.dof());
-      for (int w = next++; w < params.windows; w = next++) {
-        std::mt19937_64 rng(splitmix(params.seed ^ splitmix(static_cast<std::uint64_t>(w))));
-        long ok = 0;
-        for (int k = 0; k < params.samples; ++k) {
-          // Path parameter s in window w, then the segment and the position in it.
-          const double s = (w + unit(rng)) * segments / params.windows;
-          const int seg = std::min(segments - 1, static_cast<int>(s));
-          const double t = bounds.size() == 1 ? 0.0 : s - seg;
-          const WaypointBounds& a = bounds[static_cast<size_t>(seg)];
-          const WaypointBounds& b = bounds[std::min(bounds.size() - 1, static_cast<size_t>(seg) + 1)];
-          for (int i = 0; i < scene.dof(); ++i) {
-            const double lo = a.lower[i] + t * (b.lower[i] - a.lower[i]);
-            const double hi = a.upper[i] + t * (b.upper[i] - a.upper[i]);
-            q[i] = lo + (hi - lo) * unit(rng);
-          }
-          ok += state.in_collision(q) ? 0 : 1;
+      long ok = 0;
+      for (int k = 0; k < params.samples; ++k) {
+        // Path parameter s in window w, then the segment and the position in it.
+        const double s = (w + unit(rng)) * segments / params.windows;
+        const int seg = std::min(segments - 1, static_cast<int>(s));
+        const double t = bounds.size() == 1 ? 0.0 : s - seg;
+        const WaypointBounds& a = bounds[static_cast<size_t>(seg)];
+        const WaypointBounds& b = bounds[std::min(bounds.size() - 1, static_cast<size_t>(seg) + 1)];
+        for (int i = 0; i < scene.dof(); ++i) {
+          const double lo = a.lower[i] + t * (b.lower[i] - a.lower[i]);
+          const double hi = a.upper[i] + t * (b.upper[i] - a.upper[i]);
+          q[i] = lo + (hi - lo) * unit(rng);
         }
-        free_count[static_cast<size_t>(w)] = ok;
+        ok += state->in_collision(q) ? 0 : 1;
       }
-    } catch (...) {
-      errors[static_cast<size_t>(worker)] = std::current_exception();
-    }
-  };
-  const int workers = std::max(1, std::min(threads, params.windows));
-  std::vector<std::thread> pool;
-  for (int t = 1; t < workers; ++t) pool.emplace_back(work, t);
-  work(0);
-  for (auto& t : pool) t.join();
-  for (auto& e : errors)
-    if (e) std::rethrow_exception(e);
+      free_count[static_cast<size_t>(w)] = ok;
+    };
+  });
 
   CfResult r;
   long total_free = 0;

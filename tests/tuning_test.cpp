@@ -409,8 +409,8 @@ TEST_F(TuningTest, TheLoopImprovesOnTheStartTowardsTheKnownOptimum) {
   for (const char* v : {"d_t_lb=0.35", "d_t_ub=1.5", "d_g_lb=0.1", "d_g_ub=2", "d_ng_ub=0.5", "h_max=1.5",
                         "alpha_t=1", "alpha_g=1", "alpha_ng=1", "trail_margin=0"})
     fix += std::string(" --fix ") + v;
-  const auto r = run_tune(quick("--lambda 10000 --min-width 0 --budget-evals 15 --log " + path("log.csv") +
-                                " --out " + path("t.json") + fix));
+  const auto r = run_tune(quick("--lambda 10000 --min-width 0 --budget-evals 15 --recheck 2 --log " +
+                                path("log.csv") + " --out " + path("t.json") + fix));
   ASSERT_EQ(r.exit_code, 0) << r.out;
   const auto objective = column(read_text(path("log.csv")), "objective");
   ASSERT_EQ(objective.size(), 15u);
@@ -421,6 +421,7 @@ TEST_F(TuningTest, TheLoopImprovesOnTheStartTowardsTheKnownOptimum) {
   EXPECT_LE(tuned["height_map"]["max_cells"].get<int>(), 40) << r.out;
   EXPECT_THAT(r.out, HasSubstr("before / after"));
   EXPECT_THAT(r.out, HasSubstr("| cell:a:b | tuned |"));
+  EXPECT_THAT(r.out, HasSubstr("recheck 1: search J"));
 }
 
 TEST_F(TuningTest, ABudgetOfNEvaluationsStopsAfterN) {

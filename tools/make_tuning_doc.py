@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Runs the tuning studies of docs/tuning.md with leeway-tune and writes their numbers into it.
 
-Usage: tools/make_tuning_doc.py [--tune build/leeway-tune] [--only compare,noise,run] [--render-only]
+Usage: tools/make_tuning_doc.py [--tune build/leeway-tune] [--only compare,noise,run,noise-local]
+                                [--render-only]
                                 [--run-seconds 1080] [--threads 2]
 
 Phases (each writes docs/data/tuning/; --only picks some, --render-only runs none):
@@ -10,6 +11,7 @@ Phases (each writes docs/data/tuning/; --only picks some, --render-only runs non
   noise    the noise study: the start and random points on all nine paths, bounds repeated, CF at
            three seeds and at the summary's size (about 5 minutes)
   run      the real tuning run on all nine thesis paths (--run-seconds of search, then the summary)
+  noise-local  the noise study again, on points around the run's tuned parameters (about 3 minutes)
 Then docs/tuning.md is rewritten between its <!-- begin NAME --> / <!-- end NAME --> markers; the
 prose outside them is left as it is. Standard library only.
 """
@@ -104,10 +106,18 @@ def phase_noise(tune, threads):
     stamp("noise")
 
 
+def phase_noise_local(tune, threads):
+    run([tune] + case_args(NINE) +
+        ["--noise-study", str(NOISE_POINTS), "--noise-center", rel(DATA / "tuned.json"), "--repeats",
+         str(NOISE_REPEATS), "--seed", "4", "--threads", str(threads), "--log", rel(DATA / "noise-local.csv"),
+         "--report", rel(DATA / "noise-local.json")], "noise-local.out")
+    stamp("noise-local")
+
+
 def phase_run(tune, threads, seconds):
     run([tune] + case_args(NINE) +
         ["--budget-seconds", str(seconds), "--algorithm", RUN_ALGORITHM, "--threads", str(threads),
-         "--recheck", "3", "--log", rel(DATA / "run.csv"), "--report", rel(DATA / "run.json"),
+         "--recheck", "5", "--log", rel(DATA / "run.csv"), "--report", rel(DATA / "run.json"),
          "--out", rel(DATA / "tuned.json")], "run.out")
     stamp("run")
 
@@ -243,99 +253,117 @@ def proxy_forms(data):
     return out
 
 
-def render_noise():
-    path = DATA / "noise.csv"
-    if not path.exists():
-        return "(no noise study yet)\n"
-    data = rows(path)
-    report = json.loads((DATA / "noise.json").read_text())
+def noise_metrics(csv_path, json_path):
+    data = rows(csv_path)
+    report = json.loads(json_path.read_text())
     lam, mu = report["objective"]["lambda"], report["objective"]["mu"]
     points = sorted({int(r["point"]) for r in data})
-    # Timing noise per row.
-    wall_cv, cpu_cv, proxy_err_cpu, proxy_err_wall = [], [], [], []
+    m = {"rows": len(data), "points": len(points), "report": report, "data": data}
+    wall_cv, cpu_cv, err_cpu, err_wall, cost, cpu_med = [], [], [], [], [], []
     for r in data:
         w = [float(r[k]) for k in r if k.startswith("wall_ms_")]
         c = [float(r[k]) for k in r if k.startswith("cpu_ms_")]
         wall_cv.append((max(w) - min(w)) / statistics.median(w))
         cpu_cv.append((max(c) - min(c)) / statistics.median(c))
-        proxy_err_cpu.append(abs(float(r["cost_ms"]) - statistics.median(c)) / statistics.median(c))
-        proxy_err_wall.append(abs(float(r["cost_ms"]) - statistics.median(w)) / statistics.median(w))
-    cost = [float(r["cost_ms"]) for r in data]
-    cpu_med = [statistics.median([float(r[k]) for k in r if k.startswith("cpu_ms_")]) for r in data]
-    # CF noise: spread over the three seeds, and common against independent random numbers.
-    cf_sd = [statistics.pstdev([float(r[k]) for k in ("cf_seed_a", "cf_seed_b", "cf_seed_c")]) for r in data]
+        err_cpu.append(abs(float(r["cost_ms"]) - statistics.median(c)) / statistics.median(c))
+        err_wall.append(abs(float(r["cost_ms"]) - statistics.median(w)) / statistics.median(w))
+        cost.append(float(r["cost_ms"]))
+        cpu_med.append(statistics.median(c))
+    m["wall_cv"], m["cpu_cv"], m["err_cpu"], m["err_wall"] = wall_cv, cpu_cv, err_cpu, err_wall
+    m["proxy_spearman"] = spearman(cost, cpu_med)
+    seeds = ("cf_seed_a", "cf_seed_b", "cf_seed_c")
+    m["cf_sd"] = [statistics.pstdev([float(r[k]) for k in seeds]) for r in data]
     by_case = {}
     for r in data:
         by_case.setdefault(r["case"], {})[int(r["point"])] = r
     crn, indep = [], []
-    for case, pts in by_case.items():
+    for pts in by_case.values():
         for p, q in itertools.combinations(sorted(pts), 2):
             a, b = pts[p], pts[q]
-            seeds = ("cf_seed_a", "cf_seed_b", "cf_seed_c")
-            same = [float(a[s]) - float(b[s]) for s in seeds]
-            cross = [float(a[s]) - float(b[t]) for s, t in zip(seeds, seeds[1:] + seeds[:1])]
-            crn.append(statistics.pstdev(same))
-            indep.append(statistics.pstdev(cross))
-    # Rankings of the points by the objective aggregated (mean) over the cases.
+            crn.append(statistics.pstdev([float(a[k]) - float(b[k]) for k in seeds]))
+            indep.append(statistics.pstdev([float(a[k]) - float(b[t]) for k, t in zip(seeds, seeds[1:] + seeds[:1])]))
+    m["crn"], m["indep"] = crn, indep
     variants = {}
     for r in data:
         for k, v in noise_objectives(r, lam, mu).items():
             variants.setdefault(k, {}).setdefault(int(r["point"]), []).append(v)
     agg = {k: [statistics.fmean(v[p]) for p in points] for k, v in variants.items()}
-    ref = agg["reference_cpu"]
-    best_ref = max(range(len(points)), key=lambda i: ref[i])
-    out = []
-    out.append(f"{len(points)} parameter sets (the thesis's start and {len(points) - 1} uniformly random "
-               f"feasible points, `--seed 3`) on all nine paths; the bounding step repeated "
-               f"{report['noise_study']['repeats']} times per set and path; the CF at three seeds with the "
-               f"search's 30 x {report['objective']['cf_samples']} samples and once with 30 x "
-               f"{report['noise_study']['final_samples']} at the summary's seed. "
-               f"{len(data)} (set, path) rows in `docs/data/tuning/noise.csv`.\n")
-    out.append("| quantity | median | 90th percentile |")
-    out.append("|---|---:|---:|")
+    m["agg"] = agg
+    m["spread"] = max(agg["reference_cpu"]) - min(agg["reference_cpu"])
+    return m
 
-    def q90(v):
-        return sorted(v)[int(0.9 * (len(v) - 1))]
-    out.append(f"| wall time: (max - min) / median over the repeats | {100 * statistics.median(wall_cv):.1f} % | "
-               f"{100 * q90(wall_cv):.1f} % |")
-    out.append(f"| CPU time: (max - min) / median over the repeats | {100 * statistics.median(cpu_cv):.1f} % | "
-               f"{100 * q90(cpu_cv):.1f} % |")
-    out.append(f"| proxy against median CPU time: relative error | {100 * statistics.median(proxy_err_cpu):.1f} % | "
-               f"{100 * q90(proxy_err_cpu):.1f} % |")
-    out.append(f"| proxy against median wall time: relative error | "
-               f"{100 * statistics.median(proxy_err_wall):.1f} % | {100 * q90(proxy_err_wall):.1f} % |")
-    out.append(f"| CF (30 x {report['objective']['cf_samples']}): standard deviation over 3 seeds [% points] | "
-               f"{100 * statistics.median(cf_sd):.3f} | {100 * q90(cf_sd):.3f} |")
-    out.append(f"| CF difference of two sets, same seed (common random numbers): std. dev. [% points] | "
-               f"{100 * statistics.median(crn):.3f} | {100 * q90(crn):.3f} |")
-    out.append(f"| CF difference of two sets, different seeds: std. dev. [% points] | "
-               f"{100 * statistics.median(indep):.3f} | {100 * q90(indep):.3f} |")
+
+def q90(v):
+    return sorted(v)[int(0.9 * (len(v) - 1))]
+
+
+def render_noise():
+    studies = []
+    for name, label in (("noise", "random points"), ("noise-local", "around the tuned point")):
+        if (DATA / f"{name}.csv").exists() and (DATA / f"{name}.json").exists():
+            studies.append((label, noise_metrics(DATA / f"{name}.csv", DATA / f"{name}.json")))
+    if not studies:
+        return "(no noise study yet)\n"
+    out = []
+    first = studies[0][1]["report"]
+    out.append(f"Two studies on all nine paths, {first['noise_study']['points']} parameter sets each: *random "
+               "points* are the thesis's start and uniformly random feasible points of the whole box "
+               "(`--noise-study 20 --seed 3`); *around the tuned point* are the run's result and random moves "
+               "of every variable by up to 5 % of its range (`--noise-center docs/data/tuning/tuned.json "
+               "--seed 4`), where the search makes its finest decisions. Per set and path: the bounding step "
+               f"repeated {first['noise_study']['repeats']} times, the CF at three seeds with the search's "
+               f"30 x {first['objective']['cf_samples']} samples, and once with 30 x "
+               f"{first['noise_study']['final_samples']} at the summary's seed. Raw rows: "
+               "`docs/data/tuning/noise.csv`, `noise-local.csv`.\n")
+    head = "| quantity | " + " | ".join(f"{l}: median | 90th pct." for l, _ in studies) + " |"
+    out.append(head)
+    out.append("|---|" + "---:|---:|" * len(studies))
+
+    def line(label, key, scale=100, digits=1, unit=" %"):
+        cells = []
+        for _, m in studies:
+            v = m[key]
+            cells += [f"{scale * statistics.median(v):.{digits}f}{unit}", f"{scale * q90(v):.{digits}f}{unit}"]
+        out.append(f"| {label} | " + " | ".join(cells) + " |")
+    line("wall time: (max - min) / median of the repeats", "wall_cv")
+    line("CPU time: (max - min) / median of the repeats", "cpu_cv")
+    line("proxy against the median CPU time: relative error", "err_cpu")
+    line("proxy against the median wall time: relative error", "err_wall")
+    line(f"CF (30 x {first['objective']['cf_samples']}): std. dev. over 3 seeds [points]", "cf_sd", 100, 3, "")
+    line("CF difference of two sets, common random numbers: std. dev. [points]", "crn", 100, 3, "")
+    line("CF difference of two sets, independent seeds: std. dev. [points]", "indep", 100, 3, "")
     out.append("")
-    out.append(f"Spearman correlation of the proxy with the median CPU time over the {len(data)} rows: "
-               f"{spearman(cost, cpu_med):.4f}.\n")
-    out.append("Why the near pairs are in the proxy: both forms fitted (to relative error) on these rows' median "
-               "CPU times, in-sample relative errors:\n")
+    out.append("Spearman correlation of the proxy with the median CPU time: "
+               + "; ".join(f"{l} {m['proxy_spearman']:.4f} ({m['rows']} rows)" for l, m in studies) + ".\n")
+    out.append("Why the near pairs are in the proxy: both forms fitted (to relative error) on the random points' "
+               "median CPU times; in-sample relative errors:\n")
     out.append("| proxy form | median | 90th percentile | worst |")
     out.append("|---|---:|---:|---:|")
-    for label, med, p90, worst in proxy_forms(data):
+    for label, med, p90, worst in proxy_forms(studies[0][1]["data"]):
         out.append(f"| {label} | {100 * med:.1f} % | {100 * p90:.1f} % | {100 * worst:.1f} % |")
     out.append("")
-    out.append("Ranking of the parameter sets by J (mean over the nine paths), against the reference "
-               "ranking (CF 30 x 10,000 at a fresh seed, median CPU time):\n")
-    out.append("| J computed with | Spearman with the reference | pairs ordered as the reference | "
-               "rank of the reference's best |")
-    out.append("|---|---:|---:|---:|")
+    out.append("Ranking of the parameter sets by J (mean over the nine paths) against the reference ranking "
+               "(CF 30 x 10,000 at the unseen seed, median CPU time). Spearman correlation / share of pairs "
+               "ordered as in the reference / rank given to the reference's best set:\n")
+    out.append("| J computed with | " + " | ".join(l for l, _ in studies) + " |")
+    out.append("|---|" + "---|" * len(studies))
     names = [("search", "the search's objective: proxy time, CF 30 x 1000 at the search's seed"),
              ("seed_b", "the same at a second CF seed"),
              ("seed_c", "the same at a third CF seed"),
-             ("reference_wall", "reference CF, median wall time instead of CPU time"),
-             ("one_wall", "one wall-time measurement and CF 30 x 1000 at another seed")]
+             ("reference_wall", "the reference's CF with the median wall time"),
+             ("one_wall", "one wall-time measurement, CF 30 x 1000 at a second seed")]
     for k, label in names:
-        v = agg[k]
-        order = sorted(range(len(points)), key=lambda i: -v[i])
-        out.append(f"| {label} | {spearman(v, ref):.4f} | {100 * concordance(v, ref):.1f} % | "
-                   f"{order.index(best_ref) + 1} of {len(points)} |")
+        cells = []
+        for _, m in studies:
+            v, ref = m["agg"][k], m["agg"]["reference_cpu"]
+            best_ref = max(range(len(ref)), key=lambda i: ref[i])
+            order = sorted(range(len(v)), key=lambda i: -v[i])
+            cells.append(f"{spearman(v, ref):.3f} / {100 * concordance(v, ref):.0f} % / "
+                         f"{order.index(best_ref) + 1} of {len(v)}")
+        out.append(f"| {label} | " + " | ".join(cells) + " |")
     out.append("")
+    out.append("Range of the reference J over the sets: "
+               + "; ".join(f"{l} {m['spread']:.3f} points" for l, m in studies) + ".\n")
     return "\n".join(out)
 
 
@@ -406,8 +434,9 @@ def render_run():
         o.append("")
     rc = rep.get("recheck")
     if rc:
-        o.append("Ranking check: the 3 best distinct evaluations of the search, re-scored with the summary's CF "
-                 "and measured times (medians of 3 runs):\n")
+        o.append(f"Ranking check (`--recheck {len(rc['points'])}`): the best evaluation of the search and the next "
+                 "best ones each at least 0.02 below the previous, re-scored with the summary's CF and measured "
+                 "times (medians of 3 runs) instead of the search's CF and the proxy:\n")
         o.append("| search J | J with wall time | J with CPU time |")
         o.append("|---:|---:|---:|")
         for pt in rc["points"]:
@@ -435,7 +464,7 @@ def render():
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--tune", default="build/leeway-tune", help="the program, relative to the repository")
-    ap.add_argument("--only", default="compare,noise,run")
+    ap.add_argument("--only", default="compare,noise,run,noise-local")
     ap.add_argument("--render-only", action="store_true")
     ap.add_argument("--run-seconds", type=int, default=1080)
     ap.add_argument("--threads", type=int, default=2)
@@ -449,6 +478,8 @@ def main():
             phase_noise(args.tune, args.threads)
         if "run" in phases:
             phase_run(args.tune, args.threads, args.run_seconds)
+        if "noise-local" in phases:
+            phase_noise_local(args.tune, args.threads)
     render()
 
 

@@ -43,6 +43,7 @@ bool interrupted() { return g_interrupts > 0; }
 constexpr int kExitInterrupted = 130;  // the shell's code for a SIGINT
 constexpr size_t kCellsIndex = 9;      // log10_max_cells in tuned_variables()
 constexpr int kCalibrationRandomPoints = 24;
+constexpr double kRecheckGap = 0.02;  // J points between the rechecked evaluations
 
 double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -157,6 +158,8 @@ struct Options {
   double global_share = 0.5, step = 0.1;
   int population = 0, repeats = 0, threads = 1, waypoints = 2, final_samples = 10000, final_repeats = 3,
       recheck = 0, noise_study = 0;
+  std::string noise_center;
+  double noise_radius = 0.05;
   std::uint64_t final_seed = 2;
   bool no_summary = false;
   leeway::CfParams cf;
@@ -238,6 +241,7 @@ void load(Problem& pb) {
   require(o.final_samples >= 1, "--final-samples must be >= 1");
   require(o.recheck >= 0 && o.noise_study >= 0, "--recheck and --noise-study must be >= 0");
   require(o.noise_study == 0 || !o.log.empty(), "--noise-study writes its rows to --log FILE: give one");
+  require(o.noise_radius > 0 && o.noise_radius <= 1, "--noise-radius must be in (0, 1]");
   require(o.objective.lambda >= 0 && o.objective.mu >= 0 && o.objective.min_width >= 0,
           "--lambda, --mu and --min-width must be >= 0");
   require(o.step > 0 && o.step <= 1, "--step must be in (0, 1]");
@@ -402,14 +406,34 @@ bool calibrate(Problem& pb) {
   return true;
 }
 
-// --noise-study K: the start and K-1 random points, each on every case with the bounding step
-// repeated (wall and CPU times), the CF at three seeds of the search's size and once at the
-// summary's size. One CSV row per (point, case); tools/make_tuning_doc.py analyses them.
+// --noise-study K: the start and K-1 random points (or, with --noise-center, a point and K-1 moves
+// around it), each on every case with the bounding step repeated (wall and CPU times), the CF at
+// three seeds of the search's size and once at the summary's size. One CSV row per (point, case);
+// tools/make_tuning_doc.py analyses them.
 int noise_study(Problem& pb, std::ostream& log) {
   const Options& o = pb.o;
   std::mt19937_64 rng(o.seed);
   std::vector<std::vector<double>> points{pb.start};
-  while (static_cast<int>(points.size()) < o.noise_study) points.push_back(pb.random_point(rng));
+  if (o.noise_center.empty()) {
+    while (static_cast<int>(points.size()) < o.noise_study) points.push_back(pb.random_point(rng));
+  } else {
+    // Around a parameter file's point: each free variable moved uniformly by up to +- radius x its
+    // range, within the bounds, keeping LB + gap <= UB.
+    const std::vector<double> center =
+        leeway::variables_of(leeway::read_params(o.noise_center, pb.cases.front()->cell_params()));
+    points = {center};
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    for (int attempt = 0; static_cast<int>(points.size()) < o.noise_study; ++attempt) {
+      require(attempt < 100000, "--noise-center " + o.noise_center + ": no feasible point around it");
+      std::vector<double> x = center;
+      for (size_t i = 0; i < pb.size(); ++i)
+        if (!pb.fixed[i])
+          x[i] = std::clamp(center[i] + o.noise_radius * (pb.upper(i) - pb.lower(i)) * u(rng), pb.lower(i),
+                            pb.upper(i));
+      const auto c = leeway::bound_constraints(x);
+      if (c[0] <= 0 && c[1] <= 0) points.push_back(x);
+    }
+  }
   log << "point,case";
   for (const auto& v : pb.vars) log << "," << v.name;
   log << ",max_cells,checks,boxes,cells,cost_ms";
@@ -458,7 +482,9 @@ int noise_study(Problem& pb, std::ostream& log) {
     std::cerr << "noise study: point " << pi + 1 << " of " << points.size() << ", "
               << fixed_num(now_s() - t0, 1) << " s\n";
   }
-  pb.report["noise_study"] = {{"points", points.size()},
+  pb.report["noise_study"] = {{"center", o.noise_center.empty() ? json(nullptr) : json(o.noise_center)},
+                              {"radius", o.noise_radius},
+                              {"points", points.size()},
                               {"repeats", o.repeats},
                               {"final_samples", o.final_samples},
                               {"seconds", now_s() - t0}};
@@ -718,8 +744,8 @@ int tune(Problem& pb, std::ostream* log) {
   pb.report["summary_objective"] = totals;
   pb.write_report();
 
-  // Ranking check: the K best distinct evaluations re-scored with the summary's CF and measured
-  // times instead of the proxy.
+  // Ranking check: K of the best evaluations re-scored with the summary's CF and measured times
+  // instead of the proxy.
   if (o.recheck > 0 && g_interrupts < 2) {
     std::vector<std::pair<double, std::vector<double>>> top;
     std::map<std::vector<double>, bool> seen;
@@ -729,7 +755,14 @@ int tune(Problem& pb, std::ostream* log) {
         top.emplace_back(r.objective, r.x);
       }
     std::stable_sort(top.begin(), top.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
-    top.resize(std::min(top.size(), static_cast<size_t>(o.recheck)));
+    // A ladder: the best, then each next one at least kRecheckGap below the previous, so that the
+    // order being checked is more than the proxy's microseconds.
+    std::vector<std::pair<double, std::vector<double>>> ladder;
+    for (const auto& t : top)
+      if (ladder.size() < static_cast<size_t>(o.recheck) &&
+          (ladder.empty() || t.first <= ladder.back().first - kRecheckGap))
+        ladder.push_back(t);
+    top = ladder;
     json points = json::array();
     std::vector<double> a, b_wall, b_cpu;
     for (size_t i = 0; i < top.size() && g_interrupts < 2; ++i) {
@@ -839,6 +872,10 @@ int main(int argc, char** argv) {
   app.add_flag("--no-summary", o.no_summary, "Skip the before/after summary");
   app.add_option("--noise-study", o.noise_study,
                  "Instead of tuning: evaluate the start and K-1 random points repeatedly into --log");
+  app.add_option("--noise-center", o.noise_center,
+                 "--noise-study around this parameter file's point instead of over the whole box");
+  app.add_option("--noise-radius", o.noise_radius, "--noise-center's moves, as a fraction of each range")
+      ->capture_default_str();
   app.add_option("--tool", o.tool, "Name of the robot's tool site")->capture_default_str();
 
   try {

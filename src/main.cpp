@@ -10,6 +10,7 @@
 #include <thread>
 #include <tuple>
 
+#include "cli_parse.hpp"
 #include "leeway/check.hpp"
 #include "leeway/error.hpp"
 #include "leeway/kinematics.hpp"
@@ -291,18 +292,7 @@ int main(int argc, char** argv) {
                 << "(see leeway --help)\n";
       return leeway::kExitBadInput;
     }
-    try {
-      app.parse(argc, argv);
-    } catch (const CLI::CallForHelp& e) {
-      return app.exit(e);
-    } catch (const CLI::CallForAllHelp& e) {
-      return app.exit(e);
-    } catch (const CLI::CallForVersion& e) {
-      return app.exit(e);
-    } catch (const CLI::ParseError& e) {
-      app.exit(e);
-      return leeway::kExitBadInput;
-    }
+    if (const auto code = leeway::detail::parse_cli(app, argc, argv)) return *code;
     leeway::SceneOptions scene_opts;
     scene_opts.tool_site = tool;
 

@@ -11,6 +11,8 @@
 #include <memory>
 #include <string>
 
+#include <sys/wait.h>
+
 #include "leeway/mujoco_util.hpp"
 
 namespace leeway::test {
@@ -43,9 +45,9 @@ struct CliResult {
   std::string out;  // stdout and stderr together
 };
 
-//! Runs the leeway program with `args` (a shell-quoted string).
-inline CliResult run_cli(const std::string& args) {
-  const std::string cmd = std::string(LEEWAY_CLI) + " " + args + " 2>&1";
+//! Runs `program` with `args` (a shell-quoted string); stdout and stderr together.
+inline CliResult run_program(const std::string& program, const std::string& args) {
+  const std::string cmd = program + " " + args + " 2>&1";
   CliResult r;
   FILE* pipe = ::popen(cmd.c_str(), "r");
   if (!pipe) return r;
@@ -56,6 +58,9 @@ inline CliResult run_cli(const std::string& args) {
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
 }
+
+//! Runs the leeway program with `args` (a shell-quoted string).
+inline CliResult run_cli(const std::string& args) { return run_program(LEEWAY_CLI, args); }
 
 //! Path of a bundled workcell.
 inline std::string workcell(const std::string& name) {

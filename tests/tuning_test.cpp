@@ -80,18 +80,7 @@ std::string tune_program() {
 }
 
 // Runs leeway-tune with `args`; output is stdout and stderr together.
-test::CliResult run_tune(const std::string& args) {
-  const std::string cmd = tune_program() + " " + args + " 2>&1";
-  test::CliResult r;
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf{};
-  size_t n = 0;
-  while ((n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0) r.out.append(buf.data(), n);
-  const int status = ::pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+test::CliResult run_tune(const std::string& args) { return test::run_program(tune_program(), args); }
 
 class TuningTest : public test::MujocoTest {
  protected:
@@ -467,6 +456,46 @@ TEST_F(TuningTest, TheTunedFileRoundTripsThroughLeewayBounds) {
     EXPECT_EQ(wps[w]["lower"][0].get<double>(), run.bounds[w].lower[0]);
     EXPECT_EQ(wps[w]["upper"][0].get<double>(), run.bounds[w].upper[0]);
   }
+}
+
+// --noise-study around a parameter file: the file's point first, then moves of at most radius x range
+// per variable (d_t_lb: 0 .. 1.5 m, h_max: 0.2 .. 3 m), each feasible.
+TEST_F(TuningTest, ANoiseStudyAroundAFileStaysWithinItsRadius) {
+  const std::string center = dir_.write(
+      "center.json",
+      R"({"height_map": {"max_cells": 200}, "volume": {"d_t_lb": 0.6, "d_t_ub": 0.66, "h_max": 1.0}})");
+  const std::string log = path("noise.csv");
+  const auto r = run_tune(
+      quick("--noise-study 4 --noise-center " + center + " --noise-radius 0.05 --seed 7 --log " + log));
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const std::string csv = read_text(log);
+  const auto point = column(csv, "point"), d_t_lb = column(csv, "d_t_lb"), d_t_ub = column(csv, "d_t_ub"),
+             h_max = column(csv, "h_max"), cells = column(csv, "max_cells");
+  ASSERT_EQ(point.size(), 4u);  // one case, four points
+  EXPECT_EQ(point[0], "1");
+  EXPECT_DOUBLE_EQ(std::stod(d_t_lb[0]), 0.6);
+  EXPECT_DOUBLE_EQ(std::stod(h_max[0]), 1.0);
+  EXPECT_EQ(cells[0], "200");
+  int moved = 0;
+  for (size_t i = 1; i < 4; ++i) {
+    EXPECT_LE(std::abs(std::stod(d_t_lb[i]) - 0.6), 0.05 * 1.5 + 1e-9) << i;
+    EXPECT_LE(std::abs(std::stod(h_max[i]) - 1.0), 0.05 * 2.8 + 1e-9) << i;
+    EXPECT_LE(std::stod(d_t_lb[i]) + kMinBoundGap, std::stod(d_t_ub[i]) + 1e-9) << i;  // feasible
+    moved += std::stod(h_max[i]) != 1.0;
+  }
+  EXPECT_EQ(moved, 3);
+  // Bad centres fail before the calibration: outside the ranges, or infeasible.
+  const std::string far = dir_.write("far.json", R"({"volume": {"h_max": 5.0}})");
+  const auto outside = run_tune(quick("--noise-study 2 --noise-center " + far + " --log " + log));
+  EXPECT_EQ(outside.exit_code, kExitBadInput);
+  EXPECT_THAT(outside.out, HasSubstr("--noise-center " + far + ": 'h_max' = 5 lies outside its range"));
+  EXPECT_THAT(outside.out, Not(HasSubstr("calibrating")));
+  const auto no_study = run_tune(quick("--budget-evals 2 --noise-center " + center));
+  EXPECT_EQ(no_study.exit_code, kExitBadInput);
+  EXPECT_THAT(no_study.out, HasSubstr("--noise-center needs --noise-study K"));
+  const auto radius = run_tune(quick("--noise-study 2 --noise-radius 0 --log " + log));
+  EXPECT_EQ(radius.exit_code, kExitBadInput);
+  EXPECT_THAT(radius.out, HasSubstr("--noise-radius must be in (0, 1]"));
 }
 
 TEST_F(TuningTest, BadCasesFailBeforeAnyEvaluation) {

@@ -17,6 +17,7 @@
 #include <sstream>
 #include <thread>
 
+#include "cli_parse.hpp"
 #include "leeway/confidence.hpp"
 #include "leeway/error.hpp"
 #include "leeway/tuning.hpp"
@@ -174,6 +175,7 @@ struct Problem {
   std::vector<leeway::TunedVariable> vars;
   std::vector<bool> fixed;
   std::vector<double> start;
+  std::vector<double> noise_center;  // --noise-center's point (empty without it)
   std::vector<std::unique_ptr<TuningCase>> cases;
   std::vector<std::string> labels;
   leeway::TimeModel model;
@@ -326,6 +328,24 @@ void load(Problem& pb) {
                                         " <= d_g_ub; change --fix or --params");
   for (size_t c = 0; c < pb.cases.size(); ++c) pb.params(c, pb.start).validate();
 
+  // --noise-center: read and checked like the start, before anything is evaluated.
+  if (!o.noise_center.empty()) {
+    require(o.noise_study > 0, "--noise-center needs --noise-study K");
+    pb.noise_center =
+        leeway::variables_of(leeway::read_params(o.noise_center, pb.cases.front()->cell_params()));
+    for (size_t i = 0; i < nv; ++i) {
+      if (pb.fixed[i]) pb.noise_center[i] = fixed_value[i];
+      require(pb.noise_center[i] >= pb.lower(i) - 1e-12 && pb.noise_center[i] <= pb.upper(i) + 1e-12,
+              "--noise-center " + o.noise_center + ": '" + pb.vars[i].name +
+                  "' = " + num(pb.noise_center[i]) + " lies outside its range " + num(pb.lower(i)) + " .. " +
+                  num(pb.upper(i)));
+    }
+    const auto cc = leeway::bound_constraints(pb.noise_center);
+    require(cc[0] <= 0 && cc[1] <= 0, "--noise-center " + o.noise_center + ": the point violates d_t_lb + " +
+                                          num(leeway::kMinBoundGap) + " <= d_t_ub or d_g_lb + " +
+                                          num(leeway::kMinBoundGap) + " <= d_g_ub");
+  }
+
   // Output files: fail now rather than after the search.
   for (const auto& [file, flag] : {std::pair{o.out, "--out"}, {o.report, "--report"}, {o.log, "--log"}}) {
     if (file.empty()) continue;
@@ -419,8 +439,7 @@ int noise_study(Problem& pb, std::ostream& log) {
   } else {
     // Around a parameter file's point: each free variable moved uniformly by up to +- radius x its
     // range, within the bounds, keeping LB + gap <= UB.
-    const std::vector<double> center =
-        leeway::variables_of(leeway::read_params(o.noise_center, pb.cases.front()->cell_params()));
+    const std::vector<double>& center = pb.noise_center;
     points = {center};
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     for (int attempt = 0; static_cast<int>(points.size()) < o.noise_study; ++attempt) {
@@ -879,16 +898,7 @@ int main(int argc, char** argv) {
   app.add_option("--tool", o.tool, "Name of the robot's tool site")->capture_default_str();
 
   try {
-    try {
-      app.parse(argc, argv);
-    } catch (const CLI::CallForHelp& e) {
-      return app.exit(e);
-    } catch (const CLI::CallForAllHelp& e) {
-      return app.exit(e);
-    } catch (const CLI::ParseError& e) {
-      app.exit(e);
-      return leeway::kExitBadInput;
-    }
+    if (const auto code = leeway::detail::parse_cli(app, argc, argv)) return *code;
     if (app.count("--budget-evals") == 0 && o.budget_seconds > 0) o.budget_evals = 0;
     leeway::install_mujoco_handlers();
     pb.command = "leeway-tune";

@@ -16,10 +16,11 @@ import datetime
 import json
 import os
 import pathlib
-import platform
 import subprocess
 import sys
 import tempfile
+
+from machine_info import machine
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 PATHS = [("dallara", "home", "patch", "4.1"), ("dallara", "patch", "mould", "4.2"), ("dallara", "mould", "home", "4.3"),
@@ -53,20 +54,6 @@ def sweep(leeway, cell, src, dst, name, params, samples, tmp):
            "--samples", str(samples), "--csv", str(out), "--params", str(pfile)]
     subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     return read_csv(out)
-
-
-def machine():
-    model = "unknown CPU"
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True).stdout.strip() or "unknown"
-    return f"{model}, {os.cpu_count()} logical cores, {platform.system()} {platform.release()}; leeway commit {commit}"
 
 
 def main():

@@ -22,11 +22,12 @@ import itertools
 import json
 import os
 import pathlib
-import platform
 import re
 import statistics
 import subprocess
 import sys
+
+from machine_info import machine
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 DATA = ROOT / "docs" / "data" / "tuning"
@@ -67,18 +68,6 @@ def run(cmd, log_name):
     print(" ".join(cmd), file=sys.stderr, flush=True)
     with open(DATA / log_name, "w") as err:
         subprocess.run(cmd, check=True, cwd=ROOT, stdout=err, stderr=subprocess.STDOUT)
-
-
-def machine():
-    model = "unknown CPU"
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{model}, {os.cpu_count()} logical cores, {platform.system()} {platform.release()}"
 
 
 def stamp(name, extra=None):

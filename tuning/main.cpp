@@ -881,7 +881,8 @@ int main(int argc, char** argv) {
   app.add_option("--final-repeats", o.final_repeats, "Runs whose median is a summary time")
       ->capture_default_str();
   app.add_option("--recheck", o.recheck,
-                 "Re-score the K best evaluations with measured times and the summary's CF")
+                 "Re-score K of the best evaluations (each next one at least 0.02 below the previous in J) "
+                 "with measured times and the summary's CF")
       ->capture_default_str();
   app.add_option("--threads", o.threads, "Threads of the CF (the timed bounding step runs on one)")
       ->capture_default_str();

@@ -30,16 +30,17 @@ const VolumeField kVolumeFields[] = {
 constexpr size_t kNumVolumeFields = sizeof(kVolumeFields) / sizeof(kVolumeFields[0]);
 // Indices in the variable vector.
 constexpr size_t kCellsIndex = kNumVolumeFields;
+static_assert(kCellsIndex == kMaxCellsVariable, "kMaxCellsVariable must follow the volume fields");
 constexpr size_t kMarginIndex = kNumVolumeFields + 1;
 constexpr size_t kNumVariables = kNumVolumeFields + 2;
+
+}  // namespace
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const size_t n = v.size();
-  return n % 2 ? v[n / 2] : (v[n / 2 - 1] + v[n / 2]) / 2;
+  return n == 0 ? 0 : n % 2 ? v[n / 2] : (v[n / 2 - 1] + v[n / 2]) / 2;
 }
-
-}  // namespace
 
 std::string CaseSpec::label() const {
   return std::filesystem::path(cell).stem().string() + ":" + from + ":" + to;
@@ -124,6 +125,11 @@ std::vector<double> variables_of(const Params& p) {
 std::vector<double> bound_constraints(const std::vector<double>& x) {
   LEEWAY_DEMAND(x.size() == kNumVariables);
   return {x[0] - x[1] + kMinBoundGap, x[2] - x[3] + kMinBoundGap};
+}
+
+bool meets_bound_constraints(const std::vector<double>& x) {
+  const auto c = bound_constraints(x);
+  return std::all_of(c.begin(), c.end(), [](double v) { return v <= 0; });
 }
 
 double TimeModel::predict(long checks, long boxes, double near) const {

@@ -172,6 +172,19 @@ TEST(TunedVariablesTest, ConstraintsAreTheGapsOfBothPairs) {
   EXPECT_NEAR(c[1], 0.1 - 2.0 + kMinBoundGap, 1e-12);
   x[0] = 1.48;  // d_t_lb within the gap of d_t_ub
   EXPECT_GT(bound_constraints(x)[0], 0);
+  EXPECT_FALSE(meets_bound_constraints(x));
+  x[0] = 1.5 - 0.5;  // well below d_t_ub
+  EXPECT_TRUE(meets_bound_constraints(x));
+  x[2] = 2.0;  // d_g_lb at d_g_ub
+  EXPECT_FALSE(meets_bound_constraints(x));
+  EXPECT_TRUE(meets_bound_constraints(variables_of(Params{})));
+}
+
+TEST(MedianTest, OddEvenAndEmpty) {
+  EXPECT_EQ(median({3, 1, 2}), 2);
+  EXPECT_EQ(median({4, 1, 3, 2}), 2.5);
+  EXPECT_EQ(median({7}), 7);
+  EXPECT_EQ(median({}), 0);
 }
 
 TEST(TunedParamsJsonTest, HoldsTheTunedKeysOverTheBaseAndReadsBack) {

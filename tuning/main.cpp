@@ -42,18 +42,12 @@ extern "C" void on_sigint(int) {
 bool interrupted() { return g_interrupts > 0; }
 
 constexpr int kExitInterrupted = 130;  // the shell's code for a SIGINT
-constexpr size_t kCellsIndex = 9;      // log10_max_cells in tuned_variables()
+constexpr size_t kCellsIndex = leeway::kMaxCellsVariable;
 constexpr int kCalibrationRandomPoints = 24;
 constexpr double kRecheckGap = 0.02;  // J points between the rechecked evaluations
 
 double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n == 0 ? 0 : n % 2 ? v[n / 2] : (v[n / 2 - 1] + v[n / 2]) / 2;
 }
 
 // Ranks from 0, ties sharing their average rank.
@@ -200,12 +194,27 @@ struct Problem {
       for (size_t i = 0; i < size(); ++i)
         if (!fixed[i])
           x[i] = lower(i) + (upper(i) - lower(i)) * (static_cast<double>(rng() >> 11) * 0x1.0p-53);
-      const auto c = leeway::bound_constraints(x);
-      if (c[0] <= 0 && c[1] <= 0) return x;
+      if (leeway::meets_bound_constraints(x)) return x;
     }
     throw InputError("the variables' ranges leave almost no room for d_t_lb + " + num(leeway::kMinBoundGap) +
                      " <= d_t_ub and d_g_lb + " + num(leeway::kMinBoundGap) +
                      " <= d_g_ub; widen them with --range");
+  }
+  // x with every free variable within its range (to 1e-12, then clamped) and LB + gap <= UB.
+  // @throws InputError starting with `what` and ending with `hint` otherwise.
+  std::vector<double> checked_point(std::vector<double> x, const std::string& what,
+                                    const std::string& hint) const {
+    for (size_t i = 0; i < size(); ++i) {
+      if (fixed[i]) continue;
+      if (x[i] < vars[i].lower - 1e-12 || x[i] > vars[i].upper + 1e-12)
+        throw InputError(what + ": '" + vars[i].name + "' = " + num(x[i]) + " lies outside its range " +
+                         num(vars[i].lower) + " .. " + num(vars[i].upper) + hint);
+      x[i] = std::clamp(x[i], vars[i].lower, vars[i].upper);
+    }
+    if (!leeway::meets_bound_constraints(x))
+      throw InputError(what + " violates d_t_lb + " + num(leeway::kMinBoundGap) + " <= d_t_ub or d_g_lb + " +
+                       num(leeway::kMinBoundGap) + " <= d_g_ub" + hint);
+    return x;
   }
   void write_report() const {
     if (!o.report.empty()) leeway::write_file_atomic(o.report, report.dump(2) + "\n");
@@ -262,7 +271,6 @@ void load(Problem& pb) {
 
   // Variables: bounds from --range, values from --fix.
   pb.vars = leeway::tuned_variables();
-  LEEWAY_DEMAND(pb.vars[kCellsIndex].name == "log10_max_cells");
   const size_t nv = pb.vars.size();
   pb.fixed.assign(nv, false);
   std::vector<double> fixed_value(nv, 0);
@@ -310,40 +318,20 @@ void load(Problem& pb) {
   }
 
   // The start: the first case's parameters (the thesis's unless --params set them).
-  pb.start = leeway::variables_of(pb.cases.front()->cell_params());
-  for (size_t i = 0; i < nv; ++i) {
-    if (pb.fixed[i]) {
-      pb.start[i] = fixed_value[i];
-      continue;
-    }
-    require(pb.start[i] >= pb.vars[i].lower - 1e-12 && pb.start[i] <= pb.vars[i].upper + 1e-12,
-            "the start value of '" + pb.vars[i].name + "' (" + num(pb.start[i]) +
-                ") lies outside its range " + num(pb.vars[i].lower) + " .. " + num(pb.vars[i].upper) +
-                "; change --range or --params");
-    pb.start[i] = std::clamp(pb.start[i], pb.vars[i].lower, pb.vars[i].upper);
-  }
-  const auto c0 = leeway::bound_constraints(pb.start);
-  require(c0[0] <= 0 && c0[1] <= 0, "the start point violates d_t_lb + " + num(leeway::kMinBoundGap) +
-                                        " <= d_t_ub or d_g_lb + " + num(leeway::kMinBoundGap) +
-                                        " <= d_g_ub; change --fix or --params");
+  std::vector<double> start = leeway::variables_of(pb.cases.front()->cell_params());
+  for (size_t i = 0; i < nv; ++i)
+    if (pb.fixed[i]) start[i] = fixed_value[i];
+  pb.start = pb.checked_point(start, "the start point", "; change --range, --fix or --params");
   for (size_t c = 0; c < pb.cases.size(); ++c) pb.params(c, pb.start).validate();
 
   // --noise-center: read and checked like the start, before anything is evaluated.
   if (!o.noise_center.empty()) {
     require(o.noise_study > 0, "--noise-center needs --noise-study K");
-    pb.noise_center =
+    std::vector<double> center =
         leeway::variables_of(leeway::read_params(o.noise_center, pb.cases.front()->cell_params()));
-    for (size_t i = 0; i < nv; ++i) {
-      if (pb.fixed[i]) pb.noise_center[i] = fixed_value[i];
-      require(pb.noise_center[i] >= pb.lower(i) - 1e-12 && pb.noise_center[i] <= pb.upper(i) + 1e-12,
-              "--noise-center " + o.noise_center + ": '" + pb.vars[i].name +
-                  "' = " + num(pb.noise_center[i]) + " lies outside its range " + num(pb.lower(i)) + " .. " +
-                  num(pb.upper(i)));
-    }
-    const auto cc = leeway::bound_constraints(pb.noise_center);
-    require(cc[0] <= 0 && cc[1] <= 0, "--noise-center " + o.noise_center + ": the point violates d_t_lb + " +
-                                          num(leeway::kMinBoundGap) + " <= d_t_ub or d_g_lb + " +
-                                          num(leeway::kMinBoundGap) + " <= d_g_ub");
+    for (size_t i = 0; i < nv; ++i)
+      if (pb.fixed[i]) center[i] = fixed_value[i];
+    pb.noise_center = pb.checked_point(center, "--noise-center " + o.noise_center, "");
   }
 
   // Output files: fail now rather than after the search.
@@ -449,8 +437,7 @@ int noise_study(Problem& pb, std::ostream& log) {
         if (!pb.fixed[i])
           x[i] = std::clamp(center[i] + o.noise_radius * (pb.upper(i) - pb.lower(i)) * u(rng), pb.lower(i),
                             pb.upper(i));
-      const auto c = leeway::bound_constraints(x);
-      if (c[0] <= 0 && c[1] <= 0) points.push_back(x);
+      if (leeway::meets_bound_constraints(x)) points.push_back(x);
     }
   }
   log << "point,case";
@@ -679,7 +666,7 @@ int tune(Problem& pb, std::ostream* log) {
         cpu.push_back(e.cpu_ms);
         if (e.cpu_ms > 0) rel.push_back(std::abs(e.cost_ms - e.cpu_ms) / e.cpu_ms);
       }
-    const double rho_cpu = spearman(cost, cpu), rho_wall = spearman(cost, wall), err = median(rel);
+    const double rho_cpu = spearman(cost, cpu), rho_wall = spearman(cost, wall), err = leeway::median(rel);
     std::cout << "time proxy over the search's " << cost.size() << " runs: Spearman " << num(rho_cpu, 4)
               << " with CPU time, " << num(rho_wall, 4) << " with wall time; median relative error "
               << num(100 * err, 3) << " % (CPU)\n";
@@ -712,6 +699,18 @@ int tune(Problem& pb, std::ostream* log) {
   leeway::CfParams cf_final = o.cf;
   cf_final.samples = o.final_samples;
   cf_final.seed = o.final_seed;
+  // By case and canonical variables: the ranking check's first point is the tuned one, evaluated here.
+  std::map<std::pair<size_t, std::vector<double>>, CaseEval> final_evals;
+  auto final_eval = [&](size_t k, const std::vector<double>& x) {
+    const auto key = std::make_pair(k, pb.canonical(x));
+    auto it = final_evals.find(key);
+    if (it == final_evals.end())
+      it = final_evals
+               .emplace(key, leeway::evaluate_case(*pb.cases[k], pb.params(k, x), cf_final, o.final_repeats,
+                                                   o.threads, pb.model, objective))
+               .first;
+    return it->second;
+  };
   const int tuned_cells = best.height_map.max_cells;
   const int start_cells = leeway::max_cells_from_log10(pb.start[kCellsIndex]);
   std::vector<std::pair<std::string, std::vector<double>>> configs;
@@ -732,8 +731,7 @@ int tune(Problem& pb, std::ostream* log) {
     for (const auto& [name, x] : configs) {
       if (g_interrupts >= 2) break;
       const Params p = pb.params(k, x);
-      const auto e =
-          leeway::evaluate_case(*pb.cases[k], p, cf_final, o.final_repeats, o.threads, pb.model, objective);
+      const CaseEval e = final_eval(k, x);
       per_config[name].push_back(e);
       std::cout << "| " << pb.labels[k] << " | " << name << " | " << p.height_map.max_cells << " | "
                 << e.boxes << " | " << fixed_num(100 * e.cf, 4) << " | " << fixed_num(e.wall_ms, 1) << " ("
@@ -767,15 +765,12 @@ int tune(Problem& pb, std::ostream* log) {
   // instead of the proxy.
   if (o.recheck > 0 && g_interrupts < 2) {
     std::vector<std::pair<double, std::vector<double>>> top;
-    std::map<std::vector<double>, bool> seen;
     for (const auto& r : records)
-      if (r.feasible && !seen[pb.canonical(r.x)]) {
-        seen[pb.canonical(r.x)] = true;
-        top.emplace_back(r.objective, r.x);
-      }
+      if (r.feasible) top.emplace_back(r.objective, r.x);
     std::stable_sort(top.begin(), top.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
     // A ladder: the best, then each next one at least kRecheckGap below the previous, so that the
-    // order being checked is more than the proxy's microseconds.
+    // order being checked is more than the proxy's microseconds (and no point comes twice: equal
+    // parameters score equally).
     std::vector<std::pair<double, std::vector<double>>> ladder;
     for (const auto& t : top)
       if (ladder.size() < static_cast<size_t>(o.recheck) &&
@@ -786,9 +781,7 @@ int tune(Problem& pb, std::ostream* log) {
     std::vector<double> a, b_wall, b_cpu;
     for (size_t i = 0; i < top.size() && g_interrupts < 2; ++i) {
       std::vector<CaseEval> evs;
-      for (size_t k = 0; k < pb.cases.size(); ++k)
-        evs.push_back(leeway::evaluate_case(*pb.cases[k], pb.params(k, top[i].second), cf_final,
-                                            o.final_repeats, o.threads, pb.model, objective));
+      for (size_t k = 0; k < pb.cases.size(); ++k) evs.push_back(final_eval(k, top[i].second));
       Objective by_wall = objective, by_cpu = objective;
       by_wall.time = Objective::Time::kWall;
       by_cpu.time = Objective::Time::kCpu;

@@ -76,6 +76,9 @@ struct TunedVariable {
 //! alpha_ng, log10_max_cells, trail_margin (docs/tuning.md gives the bounds and why).
 std::vector<TunedVariable> tuned_variables();
 
+//! Index of log10_max_cells in tuned_variables().
+inline constexpr size_t kMaxCellsVariable = 9;
+
 //! Smallest gap UB - LB [m] that the constraints d_t_lb - d_t_ub + gap <= 0 and
 //! d_g_lb - d_g_ub + gap <= 0 require.
 inline constexpr double kMinBoundGap = 0.05;
@@ -92,6 +95,12 @@ std::vector<double> variables_of(const Params& p);
 
 //! The constraint values c(x) <= 0 of the two LB < UB pairs: d_t_lb - d_t_ub + gap, d_g_lb - d_g_ub + gap.
 std::vector<double> bound_constraints(const std::vector<double>& x);
+
+//! True when x meets both constraints of bound_constraints() (each value <= 0).
+bool meets_bound_constraints(const std::vector<double>& x);
+
+//! Median of `v`; 0 for an empty vector.
+double median(std::vector<double> v);
 
 //! Link-geom/box pairs whose bounding spheres overlap, averaged over the configurations: how many
 //! pairs of one collision check near these configurations get past MuJoCo's bounding-sphere test to

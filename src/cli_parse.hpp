@@ -1,8 +1,10 @@
 #pragma once
-// Internal: command-line parsing shared by the leeway and leeway-tune programs (not part of the
-// public API).
+// Internal: command-line parsing and error reporting shared by the leeway and leeway-tune programs
+// (not part of the public API).
 
 #include <CLI/CLI.hpp>
+#include <exception>
+#include <iostream>
 #include <optional>
 
 #include "leeway/error.hpp"
@@ -26,6 +28,22 @@ inline std::optional<int> parse_cli(CLI::App& app, int argc, char** argv) {
     return kExitBadInput;
   }
   return std::nullopt;
+}
+
+//! Runs a program's `body` (returning its exit code) and turns an escaping exception into one line
+//! on standard error: an InputError gives "PROGRAM: error: ..." and kExitBadInput, anything else
+//! "PROGRAM: internal error (please report): ..." and kExitInternal.
+template <class Body>
+int run_reporting_errors(const char* program, Body&& body) {
+  try {
+    return body();
+  } catch (const InputError& e) {
+    std::cerr << program << ": error: " << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const std::exception& e) {
+    std::cerr << program << ": internal error (please report): " << e.what() << "\n";
+    return kExitInternal;
+  }
 }
 
 }  // namespace leeway::detail

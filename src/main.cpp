@@ -282,7 +282,7 @@ int main(int argc, char** argv) {
       app.add_subcommand("params", "Print the default parameters as JSON (SI units), or a cell's");
   params_cmd->add_option("cell", p_file, "Also apply this cell's own defaults (MJCF custom numerics)");
 
-  try {
+  return leeway::detail::run_reporting_errors("leeway", [&]() -> int {
     // CLI11 would only say "A subcommand is required" for a mistyped one: name it.
     const std::string first = argc > 1 ? argv[1] : "";
     if (!first.empty() && first[0] != '-' && first != "check" && first != "fk" && first != "ik" &&
@@ -567,12 +567,6 @@ int main(int argc, char** argv) {
       std::cout << leeway::to_json(p).dump(2) << "\n";
       return leeway::kExitOk;
     }
-  } catch (const InputError& e) {
-    std::cerr << "leeway: error: " << e.what() << "\n";
-    return leeway::kExitBadInput;
-  } catch (const std::exception& e) {
-    std::cerr << "leeway: internal error (please report): " << e.what() << "\n";
-    return leeway::kExitInternal;
-  }
-  return leeway::kExitOk;
+    return leeway::kExitOk;
+  });
 }

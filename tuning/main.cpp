@@ -891,7 +891,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--tool", o.tool, "Name of the robot's tool site")->capture_default_str();
 
-  try {
+  return leeway::detail::run_reporting_errors("leeway-tune", [&]() -> int {
     if (const auto code = leeway::detail::parse_cli(app, argc, argv)) return *code;
     if (app.count("--budget-evals") == 0 && o.budget_seconds > 0) o.budget_evals = 0;
     leeway::install_mujoco_handlers();
@@ -910,11 +910,5 @@ int main(int argc, char** argv) {
     }
     if (o.noise_study > 0) return noise_study(pb, log);
     return tune(pb, log.is_open() ? &log : nullptr);
-  } catch (const InputError& e) {
-    std::cerr << "leeway-tune: error: " << e.what() << "\n";
-    return leeway::kExitBadInput;
-  } catch (const std::exception& e) {
-    std::cerr << "leeway-tune: internal error (please report): " << e.what() << "\n";
-    return leeway::kExitInternal;
-  }
+  });
 }

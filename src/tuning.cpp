@@ -199,7 +199,7 @@ TimeModel fit_time_model(const std::vector<TimingSample>& samples) {
   std::vector<double> rel;
   for (Eigen::Index i = 0; i < n; ++i)
     if (y[i] > 0) rel.push_back(std::abs(fit[i] - y[i]) / y[i]);
-  m.median_rel_error = rel.empty() ? 0 : median(rel);
+  m.median_rel_error = median(rel);
   m.samples = static_cast<int>(n);
   return m;
 }

@@ -1,0 +1,50 @@
+#pragma once
+//! @file safety.hpp
+//! The safety stage after Algorithms 2 and 3: shrinks the guide bounds until the whole bounded path
+//! (every waypoint box and every segment between waypoints, as leeway cf samples it) is certified
+//! free of the real obstacles, or passes an (epsilon, delta) sampling test. docs/algorithm.md.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "leeway/bounds.hpp"
+#include "leeway/certify.hpp"
+#include "leeway/params.hpp"
+#include "leeway/scene.hpp"
+
+namespace leeway {
+
+//! The outcome for one segment (waypoint k to k + 1; a one-waypoint path has one "segment").
+struct SegmentSafety {
+  bool passed = false;   //!< certified (certified mode) or sampling test passed (sampled mode)
+  long leaves = 0;       //!< certificate leaves spent on this segment, repairs included
+  int max_depth = 0;     //!< deepest subdivision
+  int shrink_steps = 0;  //!< shrink steps the repair took
+  long samples = 0;      //!< sampled mode: configurations drawn, all rounds
+  int rounds = 0;        //!< sampled mode: sampling rounds (the last one found no collision)
+};
+
+//! What the safety stage did.
+struct SafetyReport {
+  SafetyMode mode = SafetyMode::kNone;
+  bool all_passed = true;  //!< every segment certified (or passed the sampling test)
+  std::vector<SegmentSafety> segments;
+  CertifyStats stats;            //!< certificate work, all segments
+  long samples_per_segment = 0;  //!< sampled mode: N = ceil(ln(1/delta) / epsilon)
+  double ms = 0;                 //!< wall time of the stage [ms]
+};
+
+//! Samples one sampling round needs: N = ceil(ln(1/delta) / epsilon). Zero collisions in N uniform
+//! samples rejects, with confidence 1 - delta, a region whose collision share exceeds epsilon.
+long sampled_test_size(double epsilon, double delta);
+
+//! Runs the safety stage on `bounds` (waypoints in path order, linearly joined) in place: none
+//! returns at once; certified shrinks, joint by joint, toward the nominal values until every segment
+//! is certified; sampled until every segment passes the sampling test. Bounds never shrink below the
+//! nominal value. Deterministic. @throws InputError on bounds that do not fit the scene.
+//! `bound` selects the certificate's bound (the loose lever-arm bound is kept as a reference for tests
+//! and the benchmark).
+SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, const SafetyParams& params,
+                       CertifyBound bound = CertifyBound::kTaylor);
+
+}  // namespace leeway

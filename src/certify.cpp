@@ -1,0 +1,595 @@
+#include "leeway/certify.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+
+#include "leeway/error.hpp"
+
+namespace leeway {
+namespace {
+
+// A joint box being tested: its bounds, depth, and the (link, obstacle) pairs its parent could not
+// separate (pairs separated over a box stay separated over every sub-box).
+struct Cell {
+  Eigen::VectorXd lower, upper;
+  int depth = 0;
+  std::vector<int> pairs;
+};
+
+Eigen::Vector3d vec3(const double* p) { return Eigen::Vector3d(p[0], p[1], p[2]); }
+
+void check_box(const Scene& scene, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper) {
+  if (lower.size() != scene.dof() || upper.size() != scene.dof())
+    throw InputError("certify: a region needs " + std::to_string(scene.dof()) + " joint values per bound");
+  for (int i = 0; i < scene.dof(); ++i)
+    if (!std::isfinite(lower[i]) || !std::isfinite(upper[i]) || lower[i] > upper[i])
+      throw InputError("certify: joint '" + scene.joints()[static_cast<size_t>(i)].name + "' bounds [" +
+                       format_number(lower[i]) + ", " + format_number(upper[i]) +
+                       "] are not finite or not ordered");
+}
+
+}  // namespace
+
+void CertifyStats::add(const CertifyStats& o) {
+  leaves += o.leaves;
+  max_depth = std::max(max_depth, o.max_depth);
+  pair_tests += o.pair_tests;
+}
+
+Certifier::Certifier(const Scene& scene, CertifyOptions options)
+    : scene_(&scene), options_(options), state_(scene) {
+  const mjModel& m = scene.model();
+  std::vector<int> robot_index(static_cast<size_t>(m.njnt), -1);
+  for (int i = 0; i < scene.dof(); ++i)
+    robot_index[static_cast<size_t>(scene.joints()[static_cast<size_t>(i)].id)] = i;
+  for (const auto& j : scene.joints()) prismatic_.push_back(j.prismatic);
+
+  for (int g : scene.link_geoms()) {
+    Link link;
+    link.geom = g;
+    // The bodies from the geom's body up to the world, then reversed: base to tip.
+    std::vector<int> bodies;
+    for (int b = m.geom_bodyid[g]; b > 0; b = m.body_parentid[b]) bodies.push_back(b);
+    std::reverse(bodies.begin(), bodies.end());
+    // Joints in kinematic order (within a body, in model order, as mj_kinematics applies them).
+    std::vector<int> jids;
+    std::vector<size_t> body_of_joint;  // index into `bodies`
+    for (size_t k = 0; k < bodies.size(); ++k)
+      for (int jj = 0; jj < m.body_jntnum[bodies[k]]; ++jj) {
+        jids.push_back(m.body_jntadr[bodies[k]] + jj);
+        body_of_joint.push_back(k);
+      }
+    const double half_norm = [&] {
+      const Box b0 = geom_box(m, state_.data(), g);
+      return std::isfinite(b0.half_size.norm()) ? b0.half_size.norm() : 0.0;
+    }();
+    for (size_t p = 0; p < jids.size(); ++p) {
+      const int jid = jids[p];
+      const int r = robot_index[static_cast<size_t>(jid)];
+      LEEWAY_DEMAND(r >= 0);  // the scene recognises every joint on a link's chain as a robot joint
+      link.joints.push_back(r);
+      // Bound of |x - o_j| over every configuration, by the triangle inequality over the fixed
+      // offsets of the chain: the anchor's offset in its body, every later body's position in its
+      // parent, the shift of a body's origin by its own joints (at most twice their anchor
+      // offsets) and the geom's position in its body. Rotations keep lengths.
+      double lever = vec3(m.jnt_pos + 3 * jid).norm();
+      for (size_t q = p + 1; q < jids.size(); ++q) lever += 2 * vec3(m.jnt_pos + 3 * jids[q]).norm();
+      for (size_t k = body_of_joint[p] + 1; k < bodies.size(); ++k)
+        lever += vec3(m.body_pos + 3 * bodies[k]).norm();
+      lever += vec3(m.geom_pos + 3 * g).norm();
+      link.lever.push_back(lever);
+    }
+    link.corner_lever = half_norm;
+    links_.push_back(std::move(link));
+  }
+  // Obstacles are static: their world boxes once.
+  state_.set(scene.lower_limits().cwiseMax(0).cwiseMin(scene.upper_limits()));
+  for (int g : scene.obstacle_geoms()) {
+    Obstacle o;
+    o.geom = g;
+    o.box = geom_box(m, state_.data(), g);
+    o.plane = m.geom_type[g] == mjGEOM_PLANE;
+    o.radius = o.plane ? INFINITY : o.box.half_size.norm();
+    obstacles_.push_back(o);
+  }
+}
+
+bool Certifier::leaf_free(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, CertifyStats& stats,
+                          CertifyFailure* failure) {
+  check_box(*scene_, lower, upper);
+  std::vector<int> pairs(links_.size() * obstacles_.size());
+  for (size_t i = 0; i < pairs.size(); ++i) pairs[i] = static_cast<int>(i);
+  return leaf_free_impl(lower, upper, pairs, stats, failure);
+}
+
+// One leaf: every pair in `pairs` is tested at the box's centre c with half-widths h; on return
+// `pairs` holds the pairs that could not be separated (empty: the box is free).
+bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
+                               std::vector<int>& pairs, CertifyStats& stats, CertifyFailure* failure,
+                               const Eigen::VectorXd* blame) {
+  ++stats.leaves;
+  const Eigen::VectorXd c = (lower + upper) / 2;
+  const Eigen::VectorXd h = (upper - lower) / 2;
+  state_.set(c);
+  const mjModel& m = scene_->model();
+  const mjData& d = state_.data();
+  const double margin = options_.margin;
+  const size_t nobs = obstacles_.size();
+  std::vector<int> failing;
+  int last_link = -1;
+  if (failure) {
+    failure->centre_hits = false;
+    failure->gap = 0.0;
+  }
+
+  // Per link (computed when its first pair comes up): world box at c, joint Jacobian columns at the
+  // box centre, derivatives of the box axes, and the remainders.
+  Box box;
+  std::vector<Eigen::Vector3d> jac;       // d x / d q_i at c
+  std::vector<Eigen::Matrix3d> axis_jac;  // column k: d e_k / d q_i at c
+  std::vector<Eigen::Vector3d> axis;      // joint axes at c
+  std::vector<double> theta_before;       // rotation the hinges before each joint can give its axis
+  // One second-order term (p, q) of the remainder, see below.
+  struct Term {
+    size_t p = 0;
+    double coef = 0, iso = 0, var = 0, var_e = 0;
+    bool slide = false;
+    Eigen::Vector3d w = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d we = Eigen::Matrix3d::Zero();
+  };
+  std::vector<Term> terms;
+  bool terms_ready = false;
+  std::vector<double> r_pos, r_rot;  // per joint p: the remainder terms (p, q >= p) with |n x a_p| = 1
+  std::function<void()> build_terms;
+  double iso = 0;           // radius of a sphere around x(c) holding the swept link
+  double lever_radius = 0;  // the loose reference's inflation
+
+  for (int pair : pairs) {
+    ++stats.pair_tests;
+    const int li = pair / static_cast<int>(nobs);
+    const Link& link = links_[static_cast<size_t>(li)];
+    const Obstacle& obs = obstacles_[static_cast<size_t>(pair) % nobs];
+    if (li != last_link) {
+      last_link = li;
+      box = geom_box(m, d, link.geom);
+      const size_t n = link.joints.size();
+      jac.assign(n, Eigen::Vector3d::Zero());
+      axis_jac.assign(n, Eigen::Matrix3d::Zero());
+      lever_radius = 0;
+      for (size_t p = 0; p < n; ++p) {
+        const int r = link.joints[p];
+        const int jid = scene_->joints()[static_cast<size_t>(r)].id;
+        const Eigen::Vector3d a = vec3(d.xaxis + 3 * jid);
+        if (prismatic_[static_cast<size_t>(r)]) {
+          jac[p] = a;
+          lever_radius += h[r];
+        } else {
+          jac[p] = a.cross(box.center - vec3(d.xanchor + 3 * jid));
+          for (int k = 0; k < 3; ++k) axis_jac[p].col(k) = a.cross(box.rotation.col(k));
+          lever_radius += h[r] * (link.lever[p] + link.corner_lever);
+        }
+      }
+      // Lagrange remainder along the segment from c to q: 1/2 sum_pq h_p h_q sup |n . d2x/dq_p dq_q|.
+      // For p proximal to (or equal to) q, d2x/dq_p dq_q = a_p x (a_q x v_q), v_q = x - o_q (hinge
+      // q, |v_q| <= lever_q), or a_p x a_q (slide q), and 0 when p is a slide. Two bounds of its
+      // projection on n over the box, the smaller one is used:
+      //  - |n x a_p| |a_q x v_q| <= s_p(n) lever_q, s_p(n) = min(1, |n x a_p(c)| + theta_<p);
+      //  - its value at c plus how far it can move: |n . w_pq(c)| + lever_q (theta_<p + theta_<q)
+      //    + |v_q(q) - v_q(c)|, the last at most theta_<=q lever_q + sum_{r>q} h_r lever_r.
+      // theta_<p is the rotation the hinges before p can give a_p. Box axes e likewise, with
+      // a_q x e (|.| <= 1) and |e(q) - e(c)| <= theta (every hinge).
+      axis.assign(n, Eigen::Vector3d::Zero());
+      theta_before.assign(n, 0.0);
+      double before = 0;
+      for (size_t p = 0; p < n; ++p) {
+        const int rp = link.joints[p];
+        axis[p] = vec3(d.xaxis + 3 * scene_->joints()[static_cast<size_t>(rp)].id);
+        theta_before[p] = before;
+        if (!prismatic_[static_cast<size_t>(rp)]) before += h[rp];
+      }
+      const double theta = before;
+      // |v_q(q) - v_q(c)| per q.
+      std::vector<double> dv(n, 0.0);
+      for (size_t q = 0; q < n; ++q) {
+        const int rq = link.joints[q];
+        if (prismatic_[static_cast<size_t>(rq)]) continue;
+        dv[q] = (theta_before[q] + h[rq]) * link.lever[q];
+        for (size_t r = q + 1; r < n; ++r) {
+          const int rr = link.joints[r];
+          dv[q] += h[rr] * (prismatic_[static_cast<size_t>(rr)] ? 1.0 : link.lever[r]);
+        }
+      }
+      // The remainder's isotropic size (for the sphere test); its terms are built only for pairs
+      // that the sphere test does not separate.
+      double rem_iso = 0;
+      r_pos.assign(n, 0.0);
+      r_rot.assign(n, 0.0);
+      for (size_t p = 0; p < n; ++p) {
+        const int rp = link.joints[p];
+        if (prismatic_[static_cast<size_t>(rp)]) continue;
+        for (size_t q = p; q < n; ++q) {
+          const int rq = link.joints[q];
+          const bool slide = prismatic_[static_cast<size_t>(rq)];
+          const double coef = (p == q ? 0.5 : 1.0) * h[rp] * h[rq];
+          r_pos[p] += coef * (slide ? 1.0 : link.lever[q]);
+          if (!slide) r_rot[p] += coef;
+        }
+        rem_iso += r_pos[p];
+      }
+      terms_ready = false;
+      build_terms = [&, n, theta, dv, li] {
+        const Link& l = links_[static_cast<size_t>(li)];
+        terms.clear();
+        for (size_t p = 0; p < n; ++p) {
+          const int rp = l.joints[p];
+          if (prismatic_[static_cast<size_t>(rp)]) continue;
+          for (size_t q = p; q < n; ++q) {
+            const int rq = l.joints[q];
+            Term t;
+            t.p = p;
+            t.coef = (p == q ? 0.5 : 1.0) * h[rp] * h[rq];
+            if (t.coef == 0) continue;
+            const bool slide = prismatic_[static_cast<size_t>(rq)];
+            const Eigen::Vector3d anchor = vec3(d.xanchor + 3 * scene_->joints()[static_cast<size_t>(rq)].id);
+            t.w = slide ? Eigen::Vector3d(axis[p].cross(axis[q]))
+                        : Eigen::Vector3d(axis[p].cross(axis[q].cross(box.center - anchor)));
+            t.iso = slide ? 1.0 : l.lever[q];
+            t.var = t.iso * (theta_before[p] + theta_before[q]) + (slide ? 0.0 : dv[q]);
+            t.slide = slide;
+            if (!slide) {
+              for (int k = 0; k < 3; ++k) t.we.col(k) = axis[p].cross(axis[q].cross(box.rotation.col(k)));
+              t.var_e = theta_before[p] + theta_before[q] + theta;
+            }
+            terms.push_back(t);
+          }
+        }
+        terms_ready = true;
+      };
+      iso = rem_iso + box.half_size.norm();
+      for (size_t p = 0; p < n; ++p) iso += h[link.joints[p]] * jac[p].norm();
+    }
+
+    bool separated = false;
+    // The axis on which the pair came closest to separating, for the blame below.
+    Eigen::Vector3d best_axis = (obs.box.center - box.center).normalized();
+    double best_gap = -std::numeric_limits<double>::infinity();
+    // Projected radius of the swept link on a unit axis (the Taylor bound), with weights w per
+    // joint: h for the bound itself; the blame uses other weights.
+    // The swept link's projected radius on a unit axis n is first(n, h) + extent(n) + a remainder;
+    // first() and extent() are the first-order motion and the box at c, and the remainder is
+    // bounded cheaply (s_p(n) times every term's isotropic bound) or refined (per term, the
+    // smaller of that and its value at c plus its variation), see above.
+    auto first = [&](const Eigen::Vector3d& nrm, const Eigen::VectorXd& w) {
+      double r = 0;
+      for (size_t p = 0; p < jac.size(); ++p) {
+        const double wp = w[link.joints[p]];
+        if (wp == 0) continue;
+        r += wp * std::abs(nrm.dot(jac[p]));
+        for (int k = 0; k < 3; ++k) r += box.half_size[k] * wp * std::abs(nrm.dot(axis_jac[p].col(k)));
+      }
+      return r;
+    };
+    auto extent = [&](const Eigen::Vector3d& nrm) {
+      return (box.rotation.transpose() * nrm).cwiseAbs().dot(box.half_size);
+    };
+    auto s_of = [&](const Eigen::Vector3d& nrm, size_t p) {
+      return std::min(1.0, nrm.cross(axis[p]).norm() + theta_before[p]);
+    };
+    const double half_sum = box.half_size.sum();
+    auto rem_cheap = [&](const Eigen::Vector3d& nrm) {
+      double r = 0;
+      for (size_t p = 0; p < axis.size(); ++p)
+        if (r_pos[p] > 0) r += s_of(nrm, p) * (r_pos[p] + half_sum * r_rot[p]);
+      return r;
+    };
+    auto rem_refined = [&](const Eigen::Vector3d& nrm) {
+      if (!terms_ready) build_terms();
+      double s_p[16];
+      const size_t np = std::min<size_t>(axis.size(), 16);
+      for (size_t p = 0; p < np; ++p) s_p[p] = s_of(nrm, p);
+      double rem_pos = 0;
+      Eigen::Vector3d rem_rot = Eigen::Vector3d::Zero();
+      for (const Term& t : terms) {
+        const double sp = t.p < np ? s_p[t.p] : 1.0;
+        rem_pos += t.coef * std::min(sp * t.iso, std::abs(nrm.dot(t.w)) + t.var);
+        if (!t.slide)
+          for (int k = 0; k < 3; ++k)
+            rem_rot[k] += t.coef * std::min(sp, std::abs(nrm.dot(t.we.col(k))) + t.var_e);
+      }
+      return rem_pos + box.half_size.dot(rem_rot);
+    };
+    // Whether the pair is separated on axis n given the signed distance `apart` between the
+    // link's centre and the obstacle's near face along n, with the obstacle's extent removed.
+    auto separated_on = [&](const Eigen::Vector3d& nrm, double apart) {
+      const double base = apart - first(nrm, h) - extent(nrm);
+      // The refined remainder only where the cheap one fails and the rest leaves room; the gap of
+      // an axis (for the blame and the search order) is its best bound either way.
+      double g = base - rem_cheap(nrm);
+      bool sep = g > margin;
+      if (!sep && base > margin) {
+        g = base - rem_refined(nrm);
+        sep = g > margin;
+      }
+      if (g > best_gap) {
+        best_gap = g;
+        best_axis = nrm;
+      }
+      return sep;
+    };
+    if (options_.bound == CertifyBound::kLever) {
+      // The link's box at c grown by lever_radius on every side, against the obstacle.
+      Box grown = box;
+      grown.half_size.array() += lever_radius + margin;
+      if (obs.plane) {
+        const Eigen::Vector3d nrm = obs.box.rotation.col(2);
+        const double r = (box.rotation.transpose() * nrm).cwiseAbs().dot(grown.half_size);
+        separated = nrm.dot(box.center - obs.box.center) - r > 0;
+      } else {
+        separated = box_penetration(grown, obs.box) < 0;
+      }
+    } else {
+      const Eigen::Vector3d diff = obs.box.center - box.center;
+      if (!obs.plane && diff.norm() - iso - obs.radius > margin) {
+        separated = true;
+      } else if (obs.plane) {
+        const Eigen::Vector3d nrm = obs.box.rotation.col(2);
+        separated = separated_on(nrm, nrm.dot(box.center - obs.box.center));
+      } else {
+        auto try_axis = [&](const Eigen::Vector3d& candidate) {
+          const double len = candidate.norm();
+          if (len < 1e-9) return false;
+          const Eigen::Vector3d nrm = candidate / len;
+          const double ro = (obs.box.rotation.transpose() * nrm).cwiseAbs().dot(obs.box.half_size);
+          return separated_on(nrm, std::abs(nrm.dot(diff)) - ro);
+        };
+        for (int k = 0; k < 3 && !separated; ++k) separated = try_axis(obs.box.rotation.col(k));
+        for (int k = 0; k < 3 && !separated; ++k) separated = try_axis(box.rotation.col(k));
+        for (int k = 0; k < 3 && !separated; ++k)
+          for (int l = 0; l < 3 && !separated; ++l)
+            separated = try_axis(box.rotation.col(k).cross(obs.box.rotation.col(l)));
+        if (!separated) separated = try_axis(diff);
+      }
+    }
+    if (separated) continue;
+    if (failure) failure->gap = std::min(failure->gap, std::isfinite(best_gap) ? best_gap - margin : -1e9);
+    if (failing.empty() && failure) {
+      // Blame: the joint whose motion moves this link most along the axis that came closest to
+      // separating the pair (first order, plus its share of the remainder); it is the one to split
+      // or shrink. Weights: the half-widths, or `blame` when given (a probe's offsets).
+      const Eigen::VectorXd& w = blame ? *blame : h;
+      int best = -1;
+      double best_contribution = 0;
+      for (size_t p = 0; p < link.joints.size(); ++p) {
+        const int r = link.joints[p];
+        Eigen::VectorXd only = Eigen::VectorXd::Zero(w.size());
+        only[r] = w[r];
+        double contribution = first(best_axis, only);
+        if (!prismatic_[static_cast<size_t>(r)]) contribution += 0.5 * w[r] * w[r] * link.lever[p];
+        if (options_.bound == CertifyBound::kLever)
+          contribution =
+              w[r] * (prismatic_[static_cast<size_t>(r)] ? 1.0 : link.lever[p] + link.corner_lever);
+        if (contribution > best_contribution) {
+          best_contribution = contribution;
+          best = r;
+        }
+      }
+      failure->lower = lower;
+      failure->upper = upper;
+      failure->link_geom = link.geom;
+      failure->obstacle_geom = obs.geom;
+      failure->split_joint = best;
+      failure->budget = false;
+    }
+    if (failure && !failure->centre_hits) {
+      // Does the centre configuration itself come within the margin? Then no split can help.
+      Box grown = box;
+      grown.half_size.array() += margin;
+      const Eigen::Vector3d nrm = obs.box.rotation.col(2);
+      failure->centre_hits = obs.plane
+                                 ? nrm.dot(box.center - obs.box.center) -
+                                           (box.rotation.transpose() * nrm).cwiseAbs().dot(grown.half_size) <=
+                                       0
+                                 : box_penetration(grown, obs.box) >= 0;
+    }
+    failing.push_back(pair);
+  }
+  pairs = std::move(failing);
+  return pairs.empty();
+}
+
+bool Certifier::region_free_impl(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
+                                 CertifyStats& stats, CertifyFailure* failure, long budget) {
+  // Worst-first refinement: the failing leaf whose bound misses by most is split first, so a region
+  // that cannot be certified within max_depth fails after about 2 max_depth leaves instead of after
+  // certifying everything around its hard spot; a free region costs the same as any order.
+  const long start = stats.leaves;
+  CertifyFailure local;
+  auto worse = [](const std::pair<double, Cell>& x, const std::pair<double, Cell>& y) {
+    return x.first > y.first;
+  };
+  std::vector<std::pair<double, Cell>> heap;
+  auto test = [&](Cell cell) {
+    stats.max_depth = std::max(stats.max_depth, cell.depth);
+    if (leaf_free_impl(cell.lower, cell.upper, cell.pairs, stats, &local)) return true;
+    const bool exhausted = stats.leaves - start >= budget || cell.depth >= options_.max_depth;
+    if (local.split_joint < 0 || exhausted || local.centre_hits) {
+      local.budget = exhausted && local.split_joint >= 0;
+      if (failure) *failure = local;
+      return false;
+    }
+    const double key = local.gap;
+    cell.depth = cell.depth * 64 + local.split_joint;  // depth and split joint, unpacked below
+    heap.emplace_back(key, std::move(cell));
+    std::push_heap(heap.begin(), heap.end(), worse);
+    return true;
+  };
+  Cell root{lower, upper, 0, {}};
+  root.pairs.resize(links_.size() * obstacles_.size());
+  for (size_t i = 0; i < root.pairs.size(); ++i) root.pairs[i] = static_cast<int>(i);
+  if (!test(std::move(root))) return false;
+  while (!heap.empty()) {
+    std::pop_heap(heap.begin(), heap.end(), worse);
+    Cell cell = std::move(heap.back().second);
+    heap.pop_back();
+    const int j = cell.depth % 64;
+    cell.depth /= 64;
+    const double mid = (cell.lower[j] + cell.upper[j]) / 2;
+    Cell a{cell.lower, cell.upper, cell.depth + 1, cell.pairs};
+    Cell b{cell.lower, cell.upper, cell.depth + 1, std::move(cell.pairs)};
+    a.upper[j] = mid;
+    b.lower[j] = mid;
+    if (!test(std::move(a)) || !test(std::move(b))) return false;
+  }
+  return true;
+}
+
+bool Certifier::probe(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
+                      const Eigen::VectorXd& nominal, CertifyStats& stats, CertifyFailure* failure) {
+  const int n = static_cast<int>(lower.size());
+  std::vector<int> moving;
+  for (int i = 0; i < n; ++i)
+    if (upper[i] > lower[i]) moving.push_back(i);
+  const std::uint64_t corners = moving.empty()       ? 0
+                                : moving.size() <= 8 ? (std::uint64_t{1} << moving.size())
+                                                     : 256;
+  std::uint64_t state = 0x9E3779B97F4A7C15ULL;  // fixed sequence: deterministic
+  Eigen::VectorXd p(n);
+  CertifyFailure local;
+  for (std::uint64_t k = 0; k <= corners; ++k) {
+    p = (lower + upper) / 2;
+    if (k < corners) {
+      std::uint64_t bits = k;
+      if (moving.size() > 8) {
+        state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+        bits = state >> 11;
+      }
+      for (size_t m = 0; m < moving.size(); ++m)
+        p[moving[m]] = (bits >> m) & 1 ? upper[moving[m]] : lower[moving[m]];
+    }
+    std::vector<int> pairs(links_.size() * obstacles_.size());
+    for (size_t i = 0; i < pairs.size(); ++i) pairs[i] = static_cast<int>(i);
+    const Eigen::VectorXd offsets = (p - nominal).cwiseAbs();
+    if (leaf_free_impl(p, p, pairs, stats, &local, &offsets)) continue;
+    local.centre_hits = true;
+    if (failure) *failure = local;
+    return false;
+  }
+  return true;
+}
+
+bool Certifier::segment_probe(const Eigen::VectorXd& lower_a, const Eigen::VectorXd& upper_a,
+                              const Eigen::VectorXd& lower_b, const Eigen::VectorXd& upper_b,
+                              const Eigen::VectorXd& qa, const Eigen::VectorXd& qb, int samples,
+                              CertifyStats& stats, CertifyFailure* failure) {
+  check_box(*scene_, lower_a, upper_a);
+  check_box(*scene_, lower_b, upper_b);
+  CertifyFailure local;
+  for (double t : {0.0, 1.0, 0.5, 0.25, 0.75}) {
+    if (probe((1 - t) * lower_a + t * lower_b, (1 - t) * upper_a + t * upper_b, (1 - t) * qa + t * qb, stats,
+              &local))
+      continue;
+    local.t0 = local.t1 = t;
+    if (failure) *failure = local;
+    return false;
+  }
+  std::uint64_t state = 0x2545F4914F6CDD1DULL;  // fixed sequence: deterministic
+  auto unit = [&state] {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<double>(state >> 11) * 0x1.0p-53;
+  };
+  const int n = scene_->dof();
+  Eigen::VectorXd p(n);
+  for (int k = 0; k < samples; ++k) {
+    const double t = unit();
+    const Eigen::VectorXd lo = (1 - t) * lower_a + t * lower_b, hi = (1 - t) * upper_a + t * upper_b;
+    for (int i = 0; i < n; ++i) p[i] = lo[i] + (hi[i] - lo[i]) * unit();
+    const Eigen::VectorXd nominal = (1 - t) * qa + t * qb;
+    if (probe(p, p, nominal, stats, &local)) continue;
+    local.t0 = local.t1 = t;
+    if (failure) *failure = local;
+    return false;
+  }
+  return true;
+}
+
+bool Certifier::region_free(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, CertifyStats& stats,
+                            CertifyFailure* failure) {
+  check_box(*scene_, lower, upper);
+  if (!probe(lower, upper, (lower + upper) / 2, stats, failure)) return false;
+  return region_free_impl(lower, upper, stats, failure, options_.max_leaves);
+}
+
+bool Certifier::segment_free(const Eigen::VectorXd& lower_a, const Eigen::VectorXd& upper_a,
+                             const Eigen::VectorXd& lower_b, const Eigen::VectorXd& upper_b,
+                             CertifyStats& stats, CertifyFailure* failure) {
+  check_box(*scene_, lower_a, upper_a);
+  check_box(*scene_, lower_b, upper_b);
+  constexpr double kMinDt = 1.0 / (1 << 20);
+  const long start = stats.leaves;
+  std::vector<std::pair<double, double>> stack = {{0.0, 1.0}};
+  while (!stack.empty()) {
+    const auto [t0, t1] = stack.back();
+    stack.pop_back();
+    const Eigen::VectorXd lo0 = (1 - t0) * lower_a + t0 * lower_b, lo1 = (1 - t1) * lower_a + t1 * lower_b;
+    const Eigen::VectorXd hi0 = (1 - t0) * upper_a + t0 * upper_b, hi1 = (1 - t1) * upper_a + t1 * upper_b;
+    // lower(t) and upper(t) are linear in t: over [t0, t1] they stay within their end values.
+    const Eigen::VectorXd lo = lo0.cwiseMin(lo1), hi = hi0.cwiseMax(hi1);
+    const bool splittable = t1 - t0 > kMinDt;
+    // Split the path parameter first while the path's own motion over [t0, t1] dominates the box:
+    // the hull of a long diagonal stretch is mostly empty space that no configuration visits.
+    const Eigen::VectorXd motion = ((lo1 + hi1) - (lo0 + hi0)).cwiseAbs() / 2;
+    const Eigen::VectorXd half = ((hi0 - lo0).cwiseMin(hi1 - lo1)) / 2;
+    const bool dominated = ((motion.array() > 0.5 * half.array()) && (motion.array() > 1e-9)).any();
+    if (splittable && dominated) {
+      const double tm = (t0 + t1) / 2;
+      stack.push_back({tm, t1});
+      stack.push_back({t0, tm});
+      continue;
+    }
+    const long remaining = options_.max_leaves - (stats.leaves - start);
+    if (remaining <= 0) {
+      if (failure) {
+        failure->lower = lo;
+        failure->upper = hi;
+        failure->budget = true;
+        failure->t0 = t0;
+        failure->t1 = t1;
+      }
+      return false;
+    }
+    // Joint splits within a share of the remaining budget; when they do not suffice, a shorter
+    // stretch of the path may.
+    const bool worth_splitting = ((motion.array() > 0.05 * half.array()) && (motion.array() > 1e-9)).any();
+    const long share = splittable && worth_splitting ? std::max(64L, remaining / 16) : remaining;
+    CertifyFailure local;
+    if (region_free_impl(lo, hi, stats, &local, std::min(share, remaining))) continue;
+    // Not proven: is there a colliding configuration in the region itself (the boxes at t0, t1)?
+    const Eigen::VectorXd q0 = (lo0 + hi0) / 2, q1 = (lo1 + hi1) / 2;
+    for (int end = 0; end < 2 && !local.centre_hits; ++end) {
+      CertifyFailure hit;
+      if (!probe(end ? lo1 : lo0, end ? hi1 : hi0, end ? q1 : q0, stats, &hit)) {
+        local = hit;
+        local.t0 = local.t1 = end ? t1 : t0;
+        if (failure) *failure = local;
+        return false;
+      }
+    }
+    if (splittable && worth_splitting && local.split_joint >= 0 && !local.centre_hits) {
+      const double tm = (t0 + t1) / 2;
+      stack.push_back({tm, t1});
+      stack.push_back({t0, tm});
+      continue;
+    }
+    local.t0 = t0;
+    local.t1 = t1;
+    if (failure) *failure = local;
+    return false;
+  }
+  return true;
+}
+
+}  // namespace leeway

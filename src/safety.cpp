@@ -1,0 +1,277 @@
+#include "leeway/safety.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <random>
+
+#include "leeway/error.hpp"
+#include "leeway/kinematics.hpp"
+
+namespace leeway {
+namespace {
+
+// Extents below this are set to zero: the bound sits on the nominal value [rad or m].
+constexpr double kTinyExtent = 1e-6;
+// Shrink steps one segment may take before it is reported as not certified.
+constexpr int kMaxShrinkSteps = 400;
+// Steps that regrow one shrunk extent toward its guide value: bisection against the probe, then
+// the certificate (its first step tries the probe's limit itself).
+constexpr int kProbeSteps = 6;
+constexpr int kRegrowSteps = 4;
+// A shrink-phase test that ran out of leaves is tried once more with this many times the budget.
+constexpr long kEscalate = 1;
+// Random configurations a probe checks besides the corners.
+constexpr int kProbeSamples = 200;
+
+// The bounds as the nominal value and the extents below and above it, which shrink independently.
+struct Extents {
+  std::vector<Eigen::VectorXd> q, below, above;
+  explicit Extents(const std::vector<WaypointBounds>& b) {
+    for (const auto& w : b) {
+      q.push_back(w.q);
+      below.push_back(w.q - w.lower);
+      above.push_back(w.upper - w.q);
+    }
+  }
+  Eigen::VectorXd lower(size_t k) const { return q[k] - below[k]; }
+  Eigen::VectorXd upper(size_t k) const { return q[k] + above[k]; }
+};
+
+void halve(double& extent) { extent = extent / 2 < kTinyExtent ? 0.0 : extent / 2; }
+
+std::uint64_t splitmix(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15ULL;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
+  return x ^ (x >> 31);
+}
+
+double unit(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+
+// Certified mode for the segment between waypoints a and b (a == b for a one-waypoint path).
+// Shrink: while a quick probe (exact checks of corners and samples) finds a configuration too close
+// to an obstacle, and then while the certificate fails, halve the extent of the joint blamed for it,
+// on its side of the nominal value, at the end(s) of the segment that weigh most at its path
+// parameter (then at both ends; when that extent is already zero, every extent). Regrow: every
+// shrunk extent is then bisected back toward its guide value, first against the probe (cheap),
+// then against the certificate (kRegrowSteps steps), for this segment and for the previous one,
+// which shares waypoint a. `guide` holds the extents before the safety stage. A segment that cannot
+// be certified keeps only its nominal values.
+SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& guide, size_t a, size_t b,
+                              bool has_previous, CertifyStats& total) {
+  SegmentSafety s;
+  CertifyStats stats;
+  const int n = static_cast<int>(e.q[a].size());
+  auto certified = [&](size_t from, size_t to, CertifyFailure* f) {
+    return certifier.segment_free(e.lower(from), e.upper(from), e.lower(to), e.upper(to), stats, f);
+  };
+  auto probed = [&](size_t from, size_t to, CertifyFailure* f) {
+    return certifier.segment_probe(e.lower(from), e.upper(from), e.lower(to), e.upper(to), e.q[from], e.q[to],
+                                   kProbeSamples, stats, f);
+  };
+  // One shrink step for failure f; false when nothing is left to shrink.
+  auto shrink_for = [&](const CertifyFailure& f) {
+    const double tm = (f.t0 + f.t1) / 2;
+    std::vector<size_t> ends;
+    if (a == b || 1 - tm >= 0.25) ends.push_back(a);
+    if (a != b && tm >= 0.25) ends.push_back(b);
+    const int j = f.split_joint;
+    const bool above = j >= 0 && f.lower.size() == n &&
+                       (f.lower[j] + f.upper[j]) / 2 >= (1 - tm) * e.q[a][j] + tm * e.q[b][j];
+    // Halves the blamed joint's extent on its side (or, with joint < 0, every extent) at `at`.
+    auto shrink = [&](const std::vector<size_t>& at, int joint) {
+      bool any = false;
+      for (size_t k : at)
+        for (int i = 0; i < n; ++i)
+          for (int side = 0; side < 2; ++side) {
+            if (joint >= 0 && (i != joint || side != (above ? 1 : 0))) continue;
+            double& extent = side ? e.above[k][i] : e.below[k][i];
+            if (extent > 0) {
+              halve(extent);
+              any = true;
+            }
+          }
+      return any;
+    };
+    const std::vector<size_t> both = a == b ? std::vector<size_t>{a} : std::vector<size_t>{a, b};
+    return (j >= 0 && (shrink(ends, j) || shrink(both, j))) || shrink(ends, -1) || shrink(both, -1);
+  };
+  while (s.shrink_steps < kMaxShrinkSteps) {
+    CertifyFailure f;
+    if (probed(a, b, &f) && certified(a, b, &f)) {
+      s.passed = true;
+      break;
+    }
+    if (f.budget && !f.centre_hits && kEscalate > 1) {
+      // Out of leaves, not a collision: one more try with a larger budget before giving up width.
+      const CertifyOptions normal = certifier.options();
+      CertifyOptions more = normal;
+      more.max_leaves = normal.max_leaves * kEscalate;
+      certifier.set_options(more);
+      const bool pass = certified(a, b, &f);
+      certifier.set_options(normal);
+      if (pass) {
+        s.passed = true;
+        break;
+      }
+    }
+    ++s.shrink_steps;
+    if (!shrink_for(f)) break;  // nothing left to shrink: the nominal segment itself is not certified
+  }
+  if (!s.passed) {
+    for (size_t k : {a, b}) {
+      e.below[k].setZero();
+      e.above[k].setZero();
+    }
+  }
+  if (s.passed && s.shrink_steps > 0) {
+    std::vector<size_t> ends = {a};
+    if (b != a) ends.push_back(b);
+    const bool check_previous = has_previous;
+    for (int i = 0; i < n; ++i)
+      for (size_t k : ends)
+        for (int side = 0; side < 2; ++side) {
+          double& extent = side ? e.above[k][i] : e.below[k][i];
+          const double shrunk_to = extent, guide_extent = side ? guide.above[k][i] : guide.below[k][i];
+          if (!(guide_extent > shrunk_to)) continue;
+          const bool previous = check_previous && k == a;
+          // The largest extent the probe does not reject, by bisection (cheap) ...
+          double ok = shrunk_to, bad = guide_extent;
+          extent = bad;
+          if (probed(a, b, nullptr) && (!previous || probed(a - 1, a, nullptr))) {
+            ok = bad;
+          } else {
+            for (int step = 0; step < kProbeSteps; ++step) {
+              extent = (ok + bad) / 2;
+              const bool pass = probed(a, b, nullptr) && (!previous || probed(a - 1, a, nullptr));
+              (pass ? ok : bad) = extent;
+            }
+          }
+          // ... then the largest the certificate proves, between the shrunk value and that one.
+          const double probe_limit = ok;
+          ok = shrunk_to;
+          bad = probe_limit;
+          for (int step = 0; step < kRegrowSteps && bad - ok > kTinyExtent; ++step) {
+            extent = step == 0 ? bad : (ok + bad) / 2;
+            const bool pass = certified(a, b, nullptr) && (!previous || certified(a - 1, a, nullptr));
+            if (pass) {
+              ok = extent;
+              if (step == 0) break;
+            } else {
+              bad = extent;
+            }
+          }
+          extent = ok;
+        }
+  }
+  s.leaves = stats.leaves;
+  s.max_depth = stats.max_depth;
+  total.add(stats);
+  return s;
+}
+
+// Sampled mode for one segment: rounds of N samples drawn as leeway cf draws them (t uniform, every
+// joint uniform within the interpolated bounds); a round with a collision scales every extent at
+// both ends by 0.8 and the test starts again with fresh samples.
+SegmentSafety sample_segment(RobotState& state, Extents& e, size_t a, size_t b, long n_samples,
+                             std::uint64_t seed, size_t segment) {
+  SegmentSafety s;
+  const int n = static_cast<int>(e.q[a].size());
+  for (int round = 0; round < 200; ++round) {
+    ++s.rounds;
+    std::mt19937_64 rng(splitmix(seed ^ splitmix(segment * 1000003ULL + static_cast<std::uint64_t>(round))));
+    const Eigen::VectorXd la = e.lower(a), ua = e.upper(a), lb = e.lower(b), ub = e.upper(b);
+    bool hit = false;
+    Eigen::VectorXd q(n);
+    for (long k = 0; k < n_samples && !hit; ++k) {
+      const double t = a == b ? 0.0 : unit(rng);
+      for (int i = 0; i < n; ++i) {
+        const double lo = la[i] + t * (lb[i] - la[i]), hi = ua[i] + t * (ub[i] - ua[i]);
+        q[i] = lo + (hi - lo) * unit(rng);
+      }
+      ++s.samples;
+      hit = state.in_collision(q);
+    }
+    if (!hit) {
+      s.passed = true;
+      return s;
+    }
+    bool shrunk = false;
+    for (size_t k : {a, b})
+      for (int i = 0; i < n; ++i)
+        for (double* extent : {&e.below[k][i], &e.above[k][i]}) {
+          *extent = *extent * 0.8 < kTinyExtent ? 0.0 : *extent * 0.8;
+          shrunk = shrunk || *extent > 0;
+        }
+    ++s.shrink_steps;
+    if (!shrunk) {
+      // Down to the nominal segment: one more round says whether it passes.
+      continue;
+    }
+  }
+  return s;
+}
+
+}  // namespace
+
+long sampled_test_size(double epsilon, double delta) {
+  return static_cast<long>(std::ceil(std::log(1.0 / delta) / epsilon));
+}
+
+SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, const SafetyParams& params,
+                       CertifyBound bound) {
+  SafetyReport report;
+  report.mode = params.mode;
+  if (params.mode == SafetyMode::kNone || bounds.empty()) return report;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (size_t k = 0; k < bounds.size(); ++k) {
+    const auto& w = bounds[k];
+    if (w.q.size() != scene.dof() || w.lower.size() != scene.dof() || w.upper.size() != scene.dof())
+      throw InputError("bounds of waypoint " + std::to_string(k) + " have the wrong number of joints for " +
+                       scene.source());
+    if (!(w.lower.array() <= w.q.array()).all() || !(w.q.array() <= w.upper.array()).all())
+      throw InputError("bounds of waypoint " + std::to_string(k) + " do not contain the nominal value");
+  }
+  Extents e(bounds);
+  const size_t segments = std::max<size_t>(1, bounds.size() - 1);
+  if (params.mode == SafetyMode::kCertified) {
+    CertifyOptions options;
+    options.margin = params.margin;
+    options.max_leaves = params.max_leaves;
+    options.bound = bound;
+    Certifier certifier(scene, options);
+    const Extents guide(bounds);
+    for (size_t s = 0; s < segments; ++s)
+      report.segments.push_back(
+          certify_segment(certifier, e, guide, s, std::min(s + 1, bounds.size() - 1), s > 0, report.stats));
+  } else {
+    report.samples_per_segment = sampled_test_size(params.epsilon, params.delta);
+    RobotState state(scene);
+    // A later segment's shrink also shrinks the earlier segment that shares its waypoint: repeat
+    // the pass until one pass shrinks nothing, so every segment's final region passed its test.
+    for (int pass = 0; pass < 8; ++pass) {
+      report.segments.clear();
+      bool any_shrunk = false;
+      for (size_t s = 0; s < segments; ++s) {
+        auto r = sample_segment(state, e, s, std::min(s + 1, bounds.size() - 1), report.samples_per_segment,
+                                params.seed + static_cast<std::uint64_t>(pass), s);
+        any_shrunk = any_shrunk || r.shrink_steps > 0;
+        report.segments.push_back(r);
+      }
+      if (!any_shrunk) break;
+    }
+  }
+  for (const auto& s : report.segments) report.all_passed = report.all_passed && s.passed;
+  // Only shrunk sides are rewritten, so an untouched bound keeps its exact value.
+  const Extents original(bounds);
+  for (size_t k = 0; k < bounds.size(); ++k)
+    for (Eigen::Index i = 0; i < bounds[k].q.size(); ++i) {
+      if (e.below[k][i] != original.below[k][i]) bounds[k].lower[i] = bounds[k].q[i] - e.below[k][i];
+      if (e.above[k][i] != original.above[k][i]) bounds[k].upper[i] = bounds[k].q[i] + e.above[k][i];
+    }
+  report.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return report;
+}
+
+}  // namespace leeway

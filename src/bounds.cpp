@@ -122,6 +122,8 @@ WaypointBounds bound_waypoint(const Scene& scene, const CollisionFn& collides, c
       }
     bases = std::move(next);
   }
+  w.guide_lower = w.lower;
+  w.guide_upper = w.upper;
   return w;
 }
 

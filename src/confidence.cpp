@@ -32,7 +32,10 @@ std::pair<double, double> wilson_interval(long successes, long n) {
   const double denom = 1 + z * z / nn;
   const double centre = (p + z * z / (2 * nn)) / denom;
   const double half = z * std::sqrt(p * (1 - p) / nn + z * z / (4 * nn * nn)) / denom;
-  return {std::max(0.0, centre - half), std::min(1.0, centre + half)};
+  // At p = 0 or 1 the interval's end is exactly 0 or 1; rounding would put it a hair inside.
+  const double low = successes == 0 ? 0.0 : std::max(0.0, centre - half);
+  const double high = successes == n ? 1.0 : std::min(1.0, centre + half);
+  return {low, high};
 }
 
 CfResult confidence_factor(const Scene& scene, const std::vector<WaypointBounds>& bounds,

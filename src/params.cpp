@@ -50,6 +50,12 @@ void for_each_field(P& p, F&& f) {
   f("cf", "windows", p.cf.windows);
   f("cf", "samples", p.cf.samples);
   f("cf", "seed", p.cf.seed);
+  f("safety", "mode", p.safety.mode);
+  f("safety", "margin", p.safety.margin);
+  f("safety", "max_leaves", p.safety.max_leaves);
+  f("safety", "epsilon", p.safety.epsilon);
+  f("safety", "delta", p.safety.delta);
+  f("safety", "seed", p.safety.seed);
 }
 
 const char* distance_name(DistanceMode m) { return m == DistanceMode::k3d ? "3d" : "plane"; }
@@ -127,6 +133,15 @@ void read_value(const json& v, const std::string& key, const std::string& source
     wrong_type(source, key, "\"plane\" or \"3d\"", v);
 }
 
+void read_value(const json& v, const std::string& key, const std::string& source, SafetyMode& out) {
+  for (SafetyMode m : {SafetyMode::kNone, SafetyMode::kSampled, SafetyMode::kCertified})
+    if (v.is_string() && v.get<std::string>() == safety_mode_name(m)) {
+      out = m;
+      return;
+    }
+  wrong_type(source, key, "\"none\", \"sampled\" or \"certified\"", v);
+}
+
 std::string join(const std::set<std::string>& names) {
   std::string s;
   for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
@@ -177,6 +192,52 @@ void Params::validate() const {
   require_between("bounds.linear_axis_tolerance", bounds.linear_axis_tolerance, 0.0, 1.0);
   require_between("cf.windows", cf.windows, 1, std::numeric_limits<int>::max());
   require_between("cf.samples", cf.samples, 1, std::numeric_limits<int>::max());
+  if (safety.mode != SafetyMode::kNone && safety.mode != SafetyMode::kSampled &&
+      safety.mode != SafetyMode::kCertified)
+    throw InputError("parameter 'safety.mode' = " + std::to_string(static_cast<int>(safety.mode)) +
+                     " must be none, sampled or certified");
+  require_between("safety.margin", safety.margin, 0.0, 1.0);
+  require_between("safety.max_leaves", safety.max_leaves, 1, 100000000);
+  require_between("safety.epsilon", safety.epsilon, 1e-9, 0.5);
+  require_between("safety.delta", safety.delta, 1e-12, 0.5);
+}
+
+const char* safety_mode_name(SafetyMode mode) {
+  switch (mode) {
+    case SafetyMode::kNone:
+      return "none";
+    case SafetyMode::kSampled:
+      return "sampled";
+    case SafetyMode::kCertified:
+      return "certified";
+  }
+  return "?";
+}
+
+Params preset_params(const std::string& name) {
+  Params p;
+  if (name == "thesis") {
+    // Section 4.1 as published (Params' defaults), without any check against the real obstacles.
+    p.safety.mode = SafetyMode::kNone;
+    return p;
+  }
+  if (name == "leeway") {
+    // docs/data/tuning/tuned.json: leeway-tune's result for the nine thesis paths (docs/tuning.md).
+    p.height_map.max_cells = 1725;
+    p.volume.d_t_lb = 0.3756895344528792;
+    p.volume.d_t_ub = 1.77736013400714;
+    p.volume.d_g_lb = 0.9956428788490507;
+    p.volume.d_g_ub = 1.690378256532044;
+    p.volume.d_ng_ub = 0.3042948618621293;
+    p.volume.h_max = 1.7002108396343036;
+    p.volume.alpha_t = 1.7607431532670978;
+    p.volume.alpha_g = 3.9620660871306113;
+    p.volume.alpha_ng = 3.568484783491677;
+    p.volume.trail_margin = 0.05451587373395741;
+    p.safety.mode = SafetyMode::kCertified;
+    return p;
+  }
+  throw InputError("unknown preset '" + name + "' (presets: leeway, thesis)");
 }
 
 nlohmann::json to_json(const Params& p) {
@@ -184,6 +245,8 @@ nlohmann::json to_json(const Params& p) {
   for_each_field(p, [&](const char* section, const char* key, const auto& field) {
     if constexpr (std::is_same_v<std::decay_t<decltype(field)>, DistanceMode>)
       j[section][key] = distance_name(field);
+    else if constexpr (std::is_same_v<std::decay_t<decltype(field)>, SafetyMode>)
+      j[section][key] = safety_mode_name(field);
     else
       j[section][key] = field;
   });

@@ -25,6 +25,37 @@ nlohmann::json vec(const Eigen::VectorXd& v) {
 
 }  // namespace
 
+nlohmann::json safety_json(const SafetyReport& report, const SafetyParams& params) {
+  using nlohmann::json;
+  json segments = json::array();
+  for (const auto& s : report.segments) {
+    json j = {{"passed", s.passed}, {"shrink_steps", s.shrink_steps}};
+    if (report.mode == SafetyMode::kCertified) {
+      j["leaves"] = s.leaves;
+      j["max_depth"] = s.max_depth;
+    } else {
+      j["samples"] = s.samples;
+      j["rounds"] = s.rounds;
+    }
+    segments.push_back(j);
+  }
+  json out = {{"mode", safety_mode_name(report.mode)}, {"segments", segments}};
+  if (report.mode == SafetyMode::kCertified) {
+    out["certified"] = report.all_passed;
+    out["margin"] = params.margin;
+    out["max_leaves"] = params.max_leaves;
+    out["leaves"] = report.stats.leaves;
+    out["max_depth"] = report.stats.max_depth;
+  } else if (report.mode == SafetyMode::kSampled) {
+    out["passed"] = report.all_passed;
+    out["epsilon"] = params.epsilon;
+    out["delta"] = params.delta;
+    out["samples_per_segment"] = report.samples_per_segment;
+    out["seed"] = params.seed;
+  }
+  return out;
+}
+
 void apply_cell_defaults(const Scene& scene, Params& params) {
   const mjModel& m = scene.model();
   auto numeric = [&](const char* name, double& out) {
@@ -77,6 +108,9 @@ BoundsRun compute_bounds(const Scene& scene, VolumeModel& world, const std::vect
   run.bounds = bound_path(world, path, params.bounds, threads);
   run.ms_bounds = ms_since(t);
   for (const auto& b : run.bounds) run.checks += b.checks;
+  t = std::chrono::steady_clock::now();
+  run.safety = make_safe(scene, run.bounds, params.safety);
+  run.ms_safety = ms_since(t);
   return run;
 }
 
@@ -98,10 +132,21 @@ nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Param
     json collapsed = json::array();
     for (size_t i = 0; i < w.collapsed.size(); ++i)
       if (w.collapsed[i]) collapsed.push_back(scene.joints()[i].name);
+    // Per joint: how much the safety stage took off the guide interval [rad or m].
+    json shrunk = json::object();
+    if (w.guide_lower.size() == w.lower.size() && w.guide_upper.size() == w.upper.size())
+      for (Eigen::Index i = 0; i < w.lower.size(); ++i) {
+        const double below = w.lower[i] - w.guide_lower[i], above = w.guide_upper[i] - w.upper[i];
+        if (below > 0 || above > 0)
+          shrunk[scene.joints()[static_cast<size_t>(i)].name] = {{"lower_by", below}, {"upper_by", above}};
+      }
     wps.push_back({{"q", vec(w.q)},
                    {"lower", vec(w.lower)},
                    {"upper", vec(w.upper)},
                    {"collapsed", collapsed},
+                   {"shrunk", shrunk},
+                   {"guide_lower", vec(w.guide_lower)},
+                   {"guide_upper", vec(w.guide_upper)},
                    {"nominal_in_volume", w.nominal_in_volume},
                    {"checks", w.checks}});
   }
@@ -118,11 +163,10 @@ nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Param
       run.categories.goal_geom >= 0 ? json(scene.geom_label(run.categories.goal_geom)) : json(nullptr);
   out["trail_boxes"] = run.categories.trail.size();
   out["collision_checks"] = run.checks;
-  out["timing_ms"] = {{"categorize", run.ms_categorize},
-                      {"volume", run.ms_volume},
-                      {"inject", run.ms_inject},
-                      {"bounds", run.ms_bounds},
-                      {"total", run.ms_total()}};
+  out["safety"] = safety_json(run.safety, params.safety);
+  out["timing_ms"] = {{"categorize", run.ms_categorize}, {"volume", run.ms_volume},
+                      {"inject", run.ms_inject},         {"bounds", run.ms_bounds},
+                      {"safety", run.ms_safety},         {"total", run.ms_total()}};
   out["params"] = to_json(params);
   return out;
 }

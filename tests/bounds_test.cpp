@@ -240,6 +240,7 @@ class DallaraBoundsTest : public test::MujocoTest {
     scene_ = std::make_unique<Scene>(Scene::load(workcell("dallara")));
     apply_cell_defaults(*scene_, params_);
     params_.height_map.max_cells = 500;
+    params_.safety.mode = SafetyMode::kNone;  // these tests are about Algorithms 2 and 3 themselves
     world_ = std::make_unique<VolumeModel>(
         *scene_, params_.height_map.max_cells + static_cast<int>(scene_->obstacle_geoms().size()));
   }
@@ -437,6 +438,7 @@ TEST_F(BoundsSceneTest, DlrRealVolumeKeepsTheRailTolerance) {
   Params p;
   apply_cell_defaults(scene, p);
   p.height_map.max_cells = 300;
+  p.safety.mode = SafetyMode::kNone;  // the thesis's rail tolerance, before any safety stage
   VolumeModel world(scene, p.height_map.max_cells + static_cast<int>(scene.obstacle_geoms().size()));
   const auto path = keyframe_path(scene, "home", "patch", 2);
   const BoundsRun run = compute_bounds(scene, world, path, p, 2);

@@ -136,11 +136,19 @@ TEST_F(CliBoundsTest, ParamsPrintsTheCellsDefaults) {
   auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j.at("volume").at("reach_radius").get<double>(), 3.0);
   EXPECT_TRUE(j.at("volume").at("add_obstacle_boxes").get<bool>());
-  r = run_cli("params");
+  r = run_cli("params --preset thesis");
   ASSERT_EQ(r.exit_code, 0) << r.out;
   j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j.at("volume").at("reach_radius").get<double>(), 2.8);
-  EXPECT_EQ(j.at("height_map").at("max_cells").get<int>(), 20000);
+  EXPECT_EQ(j.at("height_map").at("max_cells").get<int>(), 20000);  // section 4.1's table row
+  EXPECT_EQ(j.at("volume").at("d_t_lb").get<double>(), 0.35);       // section 4.1: 350 mm
+  EXPECT_EQ(j.at("safety").at("mode").get<std::string>(), "none");
+  // The default preset: leeway-tune's parameters (docs/data/tuning/tuned.json), certified.
+  r = run_cli("params");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("height_map").at("max_cells").get<int>(), 1725);
+  EXPECT_EQ(j.at("safety").at("mode").get<std::string>(), "certified");
 }
 
 TEST_F(CliBoundsTest, BadInputsExitTwoNameTheValueAndWriteNothing) {

@@ -130,7 +130,9 @@ TEST(ParamsJsonTest, KeysAreTheFieldNames) {
   EXPECT_EQ(j.at("categorize").at("trail_densify"), 4);
   EXPECT_EQ(j.at("bounds").at("linear_axis_tolerance"), 0.05);
   EXPECT_EQ(j.at("cf").at("seed"), 18446744073709551615ull);
-  EXPECT_EQ(j.size(), 5u);
+  EXPECT_EQ(j.size(), 6u);
+  EXPECT_EQ(j.at("safety").size(), 6u);
+  EXPECT_EQ(j.at("safety").at("mode"), "certified");
   EXPECT_EQ(j.at("height_map").size(), 6u);
   EXPECT_EQ(j.at("volume").size(), 14u);  // 13 of section 4.1 and 3.2 plus trail_margin
   EXPECT_EQ(j.at("categorize").size(), 2u);

@@ -45,7 +45,10 @@ struct WaypointBounds {
   Eigen::VectorXd upper;           //!< upper bound per joint [rad or m]
   std::vector<bool> collapsed;     //!< the collapse guard widened this joint's interval
   bool nominal_in_volume = false;  //!< the nominal configuration itself touches the volume
-  long checks = 0;                 //!< collision checks spent on this waypoint
+  //! The bounds Algorithms 2 and 3 gave before the safety stage shrank them (equal to lower/upper
+  //! when nothing was shrunk or the safety mode is none).
+  Eigen::VectorXd guide_lower, guide_upper;
+  long checks = 0;  //!< collision checks spent on this waypoint
 };
 
 //! Algorithm 3 at one waypoint, using `collides` for the volume checks. Bounds always contain the

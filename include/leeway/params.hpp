@@ -74,6 +74,23 @@ struct CfParams {
   std::uint64_t seed = 1;  //!< RNG seed
 };
 
+//! How the bounds are made safe against the real obstacles after the volume-guided bisection.
+enum class SafetyMode {
+  kNone,       //!< the thesis's method as published: no check against the real obstacles
+  kSampled,    //!< shrink until an (epsilon, delta) sampling test finds no collision
+  kCertified,  //!< shrink until every waypoint box and segment is proven free (the default)
+};
+
+//! The repair stage (docs/algorithm.md, "Safe bounds").
+struct SafetyParams {
+  SafetyMode mode = SafetyMode::kCertified;
+  double margin = 0.001;   //!< certified clearance between every link and every obstacle [m]
+  int max_leaves = 16384;  //!< certificate's leaf budget per segment test
+  double epsilon = 1e-4;   //!< sampled mode: tolerated collision share
+  double delta = 0.05;     //!< sampled mode: the test passes a worse region with probability < delta
+  std::uint64_t seed = 1;  //!< sampled mode: RNG seed
+};
+
 //! All parameters.
 struct Params {
   HeightMapParams height_map;
@@ -81,11 +98,20 @@ struct Params {
   CategorizeParams categorize;
   BoundsParams bounds;
   CfParams cf;
+  SafetyParams safety;
 
   //! @throws InputError naming the parameter and value when one is out of range (NaN, negative
   //! lengths, LB >= UB, MAX_cells <= 0, ...).
   void validate() const;
 };
+
+//! The named parameter sets: "thesis" (section 4.1's height function at 20,000 cells, safety none:
+//! the published method) and "leeway" (the parameters leeway-tune found for the nine thesis paths,
+//! docs/tuning.md, with certified safety: the default). @throws InputError naming the preset.
+Params preset_params(const std::string& name);
+
+//! "none", "sampled" or "certified".
+const char* safety_mode_name(SafetyMode mode);
 
 //! Parameters as JSON (every field, SI units in the key documentation).
 nlohmann::json to_json(const Params& p);

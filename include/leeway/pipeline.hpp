@@ -11,6 +11,7 @@
 #include "leeway/bounds.hpp"
 #include "leeway/confidence.hpp"
 #include "leeway/params.hpp"
+#include "leeway/safety.hpp"
 #include "leeway/scene.hpp"
 #include "leeway/volume.hpp"
 #include "leeway/volume_world.hpp"
@@ -32,15 +33,21 @@ struct BoundsRun {
   Categories categories;
   Volume volume;
   std::vector<WaypointBounds> bounds;
+  SafetyReport safety;  //!< the safety stage (params.safety.mode)
   long checks = 0;
-  double ms_categorize = 0, ms_volume = 0, ms_inject = 0, ms_bounds = 0;
-  double ms_total() const { return ms_categorize + ms_volume + ms_inject + ms_bounds; }
+  double ms_categorize = 0, ms_volume = 0, ms_inject = 0, ms_bounds = 0, ms_safety = 0;
+  double ms_total() const { return ms_categorize + ms_volume + ms_inject + ms_bounds + ms_safety; }
 };
 
-//! Runs the method on a path against a prepared VolumeModel (its one-off set-up is not timed).
+//! Runs the method on a path against a prepared VolumeModel (its one-off set-up is not timed), then
+//! the safety stage of params.safety.mode against the real obstacles.
 //! @throws InputError on invalid parameters or waypoints.
 BoundsRun compute_bounds(const Scene& scene, VolumeModel& world, const std::vector<Eigen::VectorXd>& path,
                          const Params& params, int threads);
+
+//! The safety stage's record in a bounds file: mode, whether every segment passed, per segment
+//! leaves/depth (certified) or samples/rounds (sampled), margin or epsilon, delta and N.
+nlohmann::json safety_json(const SafetyReport& report, const SafetyParams& params);
 
 //! The bounds file (docs/cli.md): joints, waypoints (q, lower, upper), boxes, max_cells, timing_ms...
 nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Params& params);

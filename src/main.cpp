@@ -14,6 +14,7 @@
 #include "leeway/check.hpp"
 #include "leeway/error.hpp"
 #include "leeway/kinematics.hpp"
+#include "leeway/path_check.hpp"
 #include "leeway/pipeline.hpp"
 #include "leeway/planner.hpp"
 #include "leeway/scene.hpp"
@@ -58,13 +59,35 @@ Eigen::VectorXd configuration(const leeway::Scene& scene, const std::string& q, 
 
 std::string joint_unit(const leeway::RobotJoint& j) { return j.prismatic ? "m" : "rad"; }
 
-// Parameters: defaults, then the cell's own (MJCF custom numerics), then the keys present in a
-// --params file, then flags.
-leeway::Params load_params(const leeway::Scene& scene, const std::string& file) {
-  leeway::Params p;
+// Parameters: the preset, then the cell's own (MJCF custom numerics), then the keys present in a
+// --params file, then flags (--safety, --max-cells).
+leeway::Params load_params(const leeway::Scene& scene, const std::string& preset, const std::string& file,
+                           const std::string& safety) {
+  leeway::Params p = leeway::preset_params(preset);
   leeway::apply_cell_defaults(scene, p);
   if (!file.empty()) p = leeway::read_params(file, p);
+  if (!safety.empty()) {
+    if (safety == "none")
+      p.safety.mode = leeway::SafetyMode::kNone;
+    else if (safety == "sampled")
+      p.safety.mode = leeway::SafetyMode::kSampled;
+    else if (safety == "certified")
+      p.safety.mode = leeway::SafetyMode::kCertified;
+    else
+      throw InputError("--safety '" + safety + "' must be certified, sampled or none");
+  }
   return p;
+}
+
+// --preset and --safety on a subcommand that computes bounds.
+void add_preset_options(CLI::App* sub, std::string& preset, std::string& safety) {
+  sub->add_option("--preset", preset,
+                  "Parameter set: leeway (tuned parameters, certified safety) or thesis (section 4.1,\n"
+                  "no safety stage: the published method); --params and flags override it")
+      ->capture_default_str();
+  sub->add_option("--safety", safety,
+                  "certified (every interval proven free of the obstacles), sampled (an epsilon-delta\n"
+                  "sampling test) or none (the thesis's bounds as they are); default: the preset's");
 }
 
 int default_threads() { return std::max(1, static_cast<int>(std::thread::hardware_concurrency())); }
@@ -115,6 +138,41 @@ bool plan_between(const leeway::Scene& scene, const std::string& from, const std
     return false;
   }
   return true;
+}
+
+// "  (safety: lower +0.0312)": what the safety stage took off joint i's guide interval.
+std::string shrink_note(const leeway::WaypointBounds& w, int i) {
+  if (w.guide_lower.size() != w.lower.size() || w.guide_upper.size() != w.upper.size()) return "";
+  const double below = w.lower[i] - w.guide_lower[i], above = w.guide_upper[i] - w.upper[i];
+  if (!(below > 0) && !(above > 0)) return "";
+  std::ostringstream o;
+  o << std::fixed << std::setprecision(4) << "  (safety shrank it: lower +" << below << ", upper -" << above
+    << ")";
+  return o.str();
+}
+
+// One line on the safety stage: mode, outcome, work.
+void print_safety(const leeway::SafetyReport& r, const leeway::SafetyParams& params) {
+  int passed = 0;
+  for (const auto& s : r.segments) passed += s.passed ? 1 : 0;
+  const auto n = r.segments.size();
+  switch (r.mode) {
+    case leeway::SafetyMode::kNone:
+      std::cout << "safety: none (the thesis's bounds, not checked against the obstacles)\n";
+      break;
+    case leeway::SafetyMode::kCertified:
+      std::cout << "safety: certified, " << passed << " of " << n << " segments proven free (margin "
+                << leeway::format_number(params.margin) << " m; " << r.stats.leaves << " leaves, depth "
+                << r.stats.max_depth << ")"
+                << (r.all_passed ? "" : "; NOT CERTIFIED where the nominal path is too close") << "\n";
+      break;
+    case leeway::SafetyMode::kSampled:
+      std::cout << "safety: sampled, " << passed << " of " << n << " segments passed "
+                << r.samples_per_segment << " collision-free samples (epsilon "
+                << leeway::format_number(params.epsilon) << ", delta " << leeway::format_number(params.delta)
+                << ")\n";
+      break;
+  }
 }
 
 // The thesis's 20 MAX_cells values (section 4.1).
@@ -222,7 +280,9 @@ int main(int argc, char** argv) {
       "bounds",
       "Joint bounds along a path (thesis chapter 3): the joint-linear path between two keyframes, a\n"
       "planned path when --from/--to name a gripper goal (site:NAME, xyz:X,Y,Z), or every waypoint of\n"
-      "a path file (--path). Exit 0 on success, 1 unreachable goal or no path, 2 bad input.");
+      "a path file (--path). The path is checked densely first; a colliding straight path between two\n"
+      "keyframes is planned around (RRT-Connect). Exit 0 on success, 1 a colliding path, an unreachable\n"
+      "goal or no path, 2 bad input.");
   bounds->add_option("cell", b_file, "MJCF file of the workcell")->required();
   auto* b_path_opt =
       bounds->add_option("--path", b_path, "Path file written by leeway plan --out (instead of --from/--to)");
@@ -238,9 +298,15 @@ int main(int argc, char** argv) {
   bounds->add_option("--ik-seed", b_ik_seed, "Keyframe seeding the inverse kinematics of gripper goals");
   bounds->add_option("--max-cells", b_cells, "MAX_cells of the height-map (default: from --params, 20000)");
   bounds->add_option("--params", b_params, "Parameter file (JSON; see leeway params)");
+  std::string b_preset = "leeway", b_safety;
+  add_preset_options(bounds, b_preset, b_safety);
   bounds->add_option("--out", b_out, "Write the bounds file here (JSON)");
   bounds->add_option("--threads", b_threads, "Worker threads")->capture_default_str();
   bounds->add_flag("--json", b_json, "Print the bounds file to standard output");
+  bool b_no_plan = false;
+  bounds->add_flag(
+      "--no-plan", b_no_plan,
+      "Exit 1 when the straight path between two keyframes collides instead of planning around it");
 
   // cf
   std::string c_file, c_bounds;
@@ -270,6 +336,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   sweep->add_option("--max-cells", s_cells, "Comma-separated MAX_cells values (default: the thesis's 20)");
   sweep->add_option("--params", s_params, "Parameter file (JSON)");
+  std::string s_preset = "leeway", s_safety;
+  add_preset_options(sweep, s_preset, s_safety);
   sweep->add_option("--csv", s_csv, "Also write the table as CSV here");
   sweep->add_option("--windows", s_cf.windows, "CF windows")->capture_default_str();
   sweep->add_option("--samples", s_cf.samples, "CF samples per window")->capture_default_str();
@@ -281,6 +349,9 @@ int main(int argc, char** argv) {
   CLI::App* params_cmd =
       app.add_subcommand("params", "Print the default parameters as JSON (SI units), or a cell's");
   params_cmd->add_option("cell", p_file, "Also apply this cell's own defaults (MJCF custom numerics)");
+  std::string p_preset = "leeway";
+  params_cmd->add_option("--preset", p_preset, "Parameter set to print: leeway or thesis")
+      ->capture_default_str();
 
   return leeway::detail::run_reporting_errors("leeway", [&]() -> int {
     // CLI11 would only say "A subcommand is required" for a mistyped one: name it.
@@ -424,7 +495,7 @@ int main(int argc, char** argv) {
 
     if (*bounds) {
       const auto scene = leeway::Scene::load(b_file, scene_opts);
-      leeway::Params p = load_params(scene, b_params);
+      leeway::Params p = load_params(scene, b_preset, b_params, b_safety);
       if (bounds->count("--max-cells") > 0) p.height_map.max_cells = b_cells;
       p.validate();
       if (b_threads < 1) throw InputError("--threads " + std::to_string(b_threads) + " must be >= 1");
@@ -450,10 +521,90 @@ int main(int argc, char** argv) {
           return leeway::kExitFindings;
         path = planned.waypoints;
       }
+      // Issue #9: the nominal path is checked first, densely, whatever its source: the thesis's
+      // method (chapter 3) assumes it collision-free.
+      const leeway::PathCheckOptions b_check;
+      leeway::PathCheckResult checked = leeway::check_path(scene, path, b_check);
+      json nominal = {{"checked", true},
+                      {"resolution", b_check.resolution},
+                      {"slide_resolution", b_check.slide_resolution},
+                      {"planned", !linear && b_path.empty()}};
+      if (linear && !checked.free()) {
+        const leeway::PathCollision hit = *checked.collision;
+        const std::string what =
+            "the straight path from " + b_from + " to " + b_to +
+            (path.size() > 2 ? " (" + std::to_string(path.size()) + " waypoints)" : std::string()) + " " +
+            leeway::describe_collision(scene, hit, true);
+        // A keyframe that is not free itself cannot be planned around.
+        std::string stuck;
+        for (const auto& [key, q] : {std::pair{b_from, path.front()}, std::pair{b_to, path.back()}})
+          if (stuck.empty() && !leeway::check_path(scene, {q}, b_check).free()) stuck = key;
+        if (b_no_plan || !stuck.empty()) {
+          std::cerr << "leeway: collision: " << scene.source() << ": " << what
+                    << (stuck.empty() ? ""
+                                      : "; keyframe '" + stuck + "' itself is not free, so no path avoids it")
+                    << "; nothing written\n";
+          return leeway::kExitFindings;
+        }
+        leeway::PlanOptions around = b_plan;
+        around.try_direct = false;  // the straight edge may pass the planner's coarser check
+        const leeway::PlanResult planned = leeway::plan_path(scene, path.front(), path.back(), around,
+                                                             "start '" + b_from + "'", "goal '" + b_to + "'");
+        if (!planned.success) {
+          std::cerr << "leeway: no path: " << scene.source() << ": " << what << "; " << planned.message
+                    << "; nothing written\n";
+          return leeway::kExitFindings;
+        }
+        // Standard output stays one JSON object with --json.
+        (b_json ? std::cerr : std::cout)
+            << what << "; planned a path with " << planned.waypoints.size()
+            << " waypoints (RRT-Connect, seed " << around.seed << ")"
+            << (path.size() > 2
+                    ? ", which replaces the " + std::to_string(path.size()) + " straight waypoints"
+                    : std::string())
+            << "\n";
+        nominal["planned"] = true;
+        nominal["replaced_straight_path"] = {
+            {"from", b_from},
+            {"to", b_to},
+            {"waypoints", path.size()},
+            {"obstacle", hit.obstacle_geom >= 0 ? json(hit.obstacle) : json(nullptr)},
+            {"link", hit.link_geom >= 0 ? json(hit.link) : json(nullptr)},
+            {"s", hit.path_fraction},
+            {"depth", hit.depth},
+            {"q", to_array(hit.q)},
+            {"checks", checked.checks},
+            {"planner",
+             {{"name", "RRTConnect"},
+              {"seed", around.seed},
+              {"time_limit", around.time_limit},
+              {"resolution", around.resolution},
+              {"slide_resolution", around.slide_resolution},
+              {"waypoints", planned.waypoints.size()}}}};
+        path = planned.waypoints;
+        label += " (planned around '" + hit.obstacle + "')";
+        checked = leeway::check_path(scene, path, b_check);
+      }
+      if (!checked.free()) {
+        // A path file, or a planned path that passed the planner's coarser edge check.
+        const bool planned = nominal["planned"].get<bool>();
+        std::cerr << "leeway: collision: " << (b_path.empty() ? scene.source() : b_path) << ": "
+                  << (b_path.empty() ? "the path planned from " + b_from + " to " + b_to
+                                     : std::string("the path"))
+                  << " " << leeway::describe_collision(scene, *checked.collision)
+                  << (planned ? " when checked at " + leeway::format_number(b_check.resolution) +
+                                    " rad (the planner checks at " +
+                                    leeway::format_number(b_plan.resolution) + " rad)"
+                              : std::string())
+                  << "; nothing written\n";
+        return leeway::kExitFindings;
+      }
+      nominal["checks"] = checked.checks;
       leeway::VolumeModel world(scene,
                                 p.height_map.max_cells + static_cast<int>(scene.obstacle_geoms().size()));
       const auto run = leeway::compute_bounds(scene, world, path, p, b_threads);
-      const json out = leeway::bounds_json(scene, run, p);
+      json out = leeway::bounds_json(scene, run, p);
+      out["nominal_path"] = nominal;
       if (!b_out.empty()) leeway::write_file_atomic(b_out, out.dump(2) + "\n");
       if (b_json) {
         std::cout << out.dump(2) << "\n";
@@ -470,11 +621,12 @@ int main(int argc, char** argv) {
                       << run.bounds[w].lower[i] << ", " << run.bounds[w].upper[i] << "]  nominal "
                       << run.bounds[w].q[i]
                       << (run.bounds[w].collapsed[static_cast<size_t>(i)] ? "  (collapsed, widened)" : "")
-                      << "\n";
+                      << shrink_note(run.bounds[w], i) << "\n";
         }
+        print_safety(run.safety, p.safety);
         std::cout << std::setprecision(1) << "time [ms]: categorize " << run.ms_categorize << ", volume "
                   << run.ms_volume << ", inject " << run.ms_inject << ", bounds " << run.ms_bounds
-                  << ", total " << run.ms_total() << "\n";
+                  << ", safety " << run.ms_safety << ", total " << run.ms_total() << "\n";
         if (!b_out.empty()) std::cout << "wrote " << b_out << "\n";
       }
       return leeway::kExitOk;
@@ -507,7 +659,7 @@ int main(int argc, char** argv) {
 
     if (*sweep) {
       const auto scene = leeway::Scene::load(s_file, scene_opts);
-      const leeway::Params base = load_params(scene, s_params);
+      const leeway::Params base = load_params(scene, s_preset, s_params, s_safety);
       // CF settings: the parameter file's cf section unless given on the command line.
       if (sweep->count("--windows") == 0) s_cf.windows = base.cf.windows;
       if (sweep->count("--samples") == 0) s_cf.samples = base.cf.samples;
@@ -515,6 +667,15 @@ int main(int argc, char** argv) {
       const std::vector<int> cells = parse_cells_list(s_cells);
       if (s_threads < 1) throw InputError("--threads " + std::to_string(s_threads) + " must be >= 1");
       const auto path = leeway::keyframe_path(scene, s_from, s_to, s_waypoints);
+      // Issue #9: the nominal path is checked first; a sweep bounds the straight path only.
+      if (const auto checked = leeway::check_path(scene, path); !checked.free()) {
+        std::cerr << "leeway: collision: " << scene.source() << ": the straight path from " << s_from
+                  << " to " << s_to
+                  << (path.size() > 2 ? " (" + std::to_string(path.size()) + " waypoints)" : std::string())
+                  << " " << leeway::describe_collision(scene, *checked.collision, true)
+                  << "; nothing written\n";
+        return leeway::kExitFindings;
+      }
       for (int c : cells) {
         leeway::Params p = base;
         p.height_map.max_cells = c;
@@ -562,7 +723,7 @@ int main(int argc, char** argv) {
     }
 
     if (*params_cmd) {
-      leeway::Params p;
+      leeway::Params p = leeway::preset_params(p_preset);
       if (!p_file.empty()) leeway::apply_cell_defaults(leeway::Scene::load(p_file, scene_opts), p);
       std::cout << leeway::to_json(p).dump(2) << "\n";
       return leeway::kExitOk;

@@ -250,14 +250,20 @@ SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, 
     RobotState state(scene);
     // A later segment's shrink also shrinks the earlier segment that shares its waypoint: repeat
     // the pass until one pass shrinks nothing, so every segment's final region passed its test.
+    // Per segment: samples, rounds and shrink steps add up over the passes; `passed` is the last's.
+    report.segments.assign(segments, SegmentSafety{});
     for (int pass = 0; pass < 8; ++pass) {
-      report.segments.clear();
       bool any_shrunk = false;
       for (size_t s = 0; s < segments; ++s) {
-        auto r = sample_segment(state, e, s, std::min(s + 1, bounds.size() - 1), report.samples_per_segment,
-                                params.seed + static_cast<std::uint64_t>(pass), s);
+        const auto r =
+            sample_segment(state, e, s, std::min(s + 1, bounds.size() - 1), report.samples_per_segment,
+                           params.seed + static_cast<std::uint64_t>(pass), s);
         any_shrunk = any_shrunk || r.shrink_steps > 0;
-        report.segments.push_back(r);
+        SegmentSafety& total = report.segments[s];
+        total.passed = r.passed;
+        total.samples += r.samples;
+        total.rounds += r.rounds;
+        total.shrink_steps += r.shrink_steps;
       }
       if (!any_shrunk) break;
     }

@@ -20,8 +20,9 @@ struct SegmentSafety {
   long leaves = 0;       //!< certificate leaves spent on this segment, repairs included
   int max_depth = 0;     //!< deepest subdivision
   int shrink_steps = 0;  //!< shrink steps the repair took
-  long samples = 0;      //!< sampled mode: configurations drawn, all rounds
-  int rounds = 0;        //!< sampled mode: sampling rounds (the last one found no collision)
+  long samples = 0;      //!< sampled mode: configurations drawn, all rounds and passes
+  int rounds =
+      0;  //!< sampled mode: sampling rounds, all passes (the last one found no collision when passed)
 };
 
 //! What the safety stage did.

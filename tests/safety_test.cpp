@@ -1,0 +1,247 @@
+// The safety stage (issue 9): bounds shrunk until every segment is certified free of the real
+// obstacles, the sampled mode, the presets, and the thesis's method left exactly as it was.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "leeway/confidence.hpp"
+#include "leeway/pipeline.hpp"
+#include "leeway/safety.hpp"
+#include "test_util.hpp"
+
+namespace leeway {
+namespace {
+
+using nlohmann::json;
+using test::run_cli;
+using test::workcell;
+using ::testing::HasSubstr;
+
+json read_json(const std::string& p) {
+  std::ifstream in(p);
+  return json::parse(in);
+}
+
+// The one-link arm of test_util.hpp (a 1 m link, half-height 0.05 m, rotating about z) with a wall
+// whose near face is the plane y = 0.95. The link's corner (1, 0.05) reaches it when
+// sin(t) + 0.05 cos(t) = 0.95, t = asin(0.95 / sqrt(1.0025)) - atan(0.05) = 1.19950 rad, and comes
+// within 1 mm of it at sin(t) + 0.05 cos(t) = 0.949, 0.00316 rad earlier (the derivative there is
+// cos(t) - 0.05 sin(t) = 0.3624 - 0.0466 = 0.3158).
+const char* kWall = R"(<geom name="wall" type="box" size="1 0.05 1" pos="0 1 1"/>)";
+const double kTouch = std::asin(0.95 / std::sqrt(1.0025)) - std::atan(0.05);
+const double kWithinMargin = 0.001 / (std::cos(kTouch) - 0.05 * std::sin(kTouch));
+
+WaypointBounds box_around(double q, double lower, double upper) {
+  WaypointBounds w;
+  w.q = Eigen::VectorXd::Constant(1, q);
+  w.lower = Eigen::VectorXd::Constant(1, lower);
+  w.upper = Eigen::VectorXd::Constant(1, upper);
+  w.guide_lower = w.lower;
+  w.guide_upper = w.upper;
+  w.collapsed.assign(1, false);
+  return w;
+}
+
+class OneLinkSafetyTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    path_ = dir_.write("one_link.xml", test::one_link_cell(kWall));
+    scene_ = std::make_unique<Scene>(Scene::load(path_));
+  }
+  test::TempDir dir_;
+  std::string path_;
+  std::unique_ptr<Scene> scene_;
+};
+
+TEST_F(OneLinkSafetyTest, HandComputedTouchAngle) {
+  // The worked numbers above, checked against the exact collision test.
+  EXPECT_NEAR(kTouch, 1.19950, 1e-5);
+  EXPECT_NEAR(kWithinMargin, 0.00316, 1e-5);
+  RobotState state(*scene_);
+  EXPECT_FALSE(state.in_collision(Eigen::VectorXd::Constant(1, kTouch - 1e-4)));
+  EXPECT_TRUE(state.in_collision(Eigen::VectorXd::Constant(1, kTouch + 1e-4)));
+}
+
+TEST_F(OneLinkSafetyTest, CertifiedShrinksOnlyTheSideThatHitsTheWall) {
+  // Guide [-0.5, 2.0] around 0: the upper side reaches through the wall, the lower side is free.
+  std::vector<WaypointBounds> bounds = {box_around(0.0, -0.5, 2.0), box_around(0.3, -0.2, 2.0)};
+  const SafetyReport r = make_safe(*scene_, bounds, SafetyParams{});
+  ASSERT_EQ(r.segments.size(), 1u);
+  EXPECT_TRUE(r.all_passed);
+  EXPECT_TRUE(r.segments[0].passed);
+  EXPECT_GT(r.stats.leaves, 0);
+  for (const auto& w : bounds) {
+    // Sound: within 1 mm of the wall is never allowed ...
+    EXPECT_LE(w.upper[0], kTouch - kWithinMargin + 1e-9);
+    // ... and wide: the repair gives back most of what is free (bisection to a few centiradians).
+    EXPECT_GE(w.upper[0], kTouch - 0.15);
+  }
+  // The free side is not touched, exactly.
+  EXPECT_EQ(bounds[0].lower[0], -0.5);
+  EXPECT_EQ(bounds[1].lower[0], -0.2);
+}
+
+TEST_F(OneLinkSafetyTest, NoneLeavesTheBoundsAsTheyAre) {
+  std::vector<WaypointBounds> bounds = {box_around(0.0, -0.5, 2.0), box_around(0.3, -0.2, 2.0)};
+  SafetyParams p;
+  p.mode = SafetyMode::kNone;
+  const SafetyReport r = make_safe(*scene_, bounds, p);
+  EXPECT_TRUE(r.segments.empty());
+  EXPECT_EQ(bounds[0].upper[0], 2.0);
+  EXPECT_EQ(bounds[1].upper[0], 2.0);
+}
+
+TEST_F(OneLinkSafetyTest, ANominalWithinTheMarginIsNotCertifiedAndKeepsOnlyTheNominalValues) {
+  // Nominal 0.5 mrad before contact: inside the 1 mm margin, free by the exact test.
+  const double q = kTouch - 0.0005;
+  std::vector<WaypointBounds> bounds = {box_around(q, q - 0.3, q), box_around(q, q - 0.3, q)};
+  const SafetyReport r = make_safe(*scene_, bounds, SafetyParams{});
+  EXPECT_FALSE(r.all_passed);
+  for (const auto& w : bounds) {
+    EXPECT_EQ(w.lower[0], q);
+    EXPECT_EQ(w.upper[0], q);
+  }
+}
+
+TEST_F(OneLinkSafetyTest, SampledModeRunsTheEpsilonDeltaTest) {
+  // N = ceil(ln(1 / 0.05) / 1e-4) = ceil(29957.32) = 29958.
+  EXPECT_EQ(sampled_test_size(1e-4, 0.05), 29958);
+  EXPECT_EQ(sampled_test_size(0.01, 0.01), 461);  // ln(100) / 0.01 = 460.517
+  std::vector<WaypointBounds> bounds = {box_around(0.0, -0.5, 2.0), box_around(0.3, -0.2, 2.0)};
+  SafetyParams p;
+  p.mode = SafetyMode::kSampled;
+  const SafetyReport r = make_safe(*scene_, bounds, p);
+  EXPECT_EQ(r.samples_per_segment, 29958);
+  ASSERT_EQ(r.segments.size(), 1u);
+  EXPECT_TRUE(r.segments[0].passed);
+  // The guide reaches through the wall: a round hits it and shrinks, the last round passes clean.
+  EXPECT_GE(r.segments[0].rounds, 2);
+  EXPECT_GE(r.segments[0].shrink_steps, 1);
+  EXPECT_GE(r.segments[0].samples, 29958);
+  for (const auto& w : bounds) EXPECT_LT(w.upper[0], kTouch);
+  // Deterministic for a seed.
+  std::vector<WaypointBounds> again = {box_around(0.0, -0.5, 2.0), box_around(0.3, -0.2, 2.0)};
+  make_safe(*scene_, again, p);
+  EXPECT_EQ(again[0].upper[0], bounds[0].upper[0]);
+  EXPECT_EQ(again[1].lower[0], bounds[1].lower[0]);
+}
+
+// The bounds of a run, per waypoint, as "lower" and "upper" arrays of a bounds file.
+std::vector<std::pair<std::vector<double>, std::vector<double>>> intervals(const json& j) {
+  std::vector<std::pair<std::vector<double>, std::vector<double>>> out;
+  for (const auto& w : j.at("waypoints"))
+    out.emplace_back(w.at("lower").get<std::vector<double>>(), w.at("upper").get<std::vector<double>>());
+  return out;
+}
+
+class CliSafetyTest : public ::testing::Test {
+ protected:
+  std::string file(const std::string& name) const { return (dir_.path() / name).string(); }
+  test::TempDir dir_;
+};
+
+// Certified bounds (the default) on each thesis cell: leeway cf, the independent judge, finds no
+// collision in 30 x 10,000 samples, and the file says every segment is certified.
+TEST_F(CliSafetyTest, CertifiedBoundsScoreNoCollisionOnTheThreeCells) {
+  for (const auto& [cell, from, to] :
+       {std::tuple{"dallara", "patch", "mould"}, std::tuple{"baltico", "home", "patch"},
+        std::tuple{"dlr", "mould", "home"}}) {
+    SCOPED_TRACE(cell);
+    const std::string out = file(std::string(cell) + ".json");
+    const auto b = run_cli("bounds " + workcell(cell) + " --from " + from + " --to " + to + " --out " + out);
+    ASSERT_EQ(b.exit_code, 0) << b.out;
+    EXPECT_THAT(b.out, HasSubstr("safety: certified, 1 of 1 segments proven free"));
+    const json j = read_json(out);
+    EXPECT_EQ(j.at("safety").at("mode"), "certified");
+    EXPECT_TRUE(j.at("safety").at("certified").get<bool>());
+    EXPECT_GT(j.at("safety").at("leaves").get<long>(), 0);
+    const auto r = run_cli("cf " + workcell(cell) + " " + out + " --json");
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    const json cf = json::parse(r.out);
+    EXPECT_EQ(cf.at("samples").get<long>(), 300000);
+    EXPECT_EQ(cf.at("collisions").get<long>(), 0);
+    EXPECT_EQ(cf.at("cf").get<double>(), 1.0);
+    // Shrunk intervals lie within the guide and keep the nominal value.
+    for (const auto& w : j.at("waypoints"))
+      for (size_t i = 0; i < w.at("q").size(); ++i) {
+        EXPECT_GE(w.at("lower")[i].get<double>(), w.at("guide_lower")[i].get<double>());
+        EXPECT_LE(w.at("upper")[i].get<double>(), w.at("guide_upper")[i].get<double>());
+        EXPECT_LE(w.at("lower")[i].get<double>(), w.at("q")[i].get<double>());
+        EXPECT_GE(w.at("upper")[i].get<double>(), w.at("q")[i].get<double>());
+      }
+  }
+}
+
+// The thesis preset (safety none) reproduces, to the last bit, the bounds leeway 0.1.0 (b3f0610,
+// before the safety stage existed) wrote with its defaults, which were the thesis's parameters.
+// tests/data/thesis_bounds/*.json were written by that build: `leeway bounds CELL --from A --to B
+// --max-cells 2000 --out ...`.
+TEST_F(CliSafetyTest, ThesisPresetReproducesTheBoundsOfBeforeTheSafetyStage) {
+  for (const auto& [cell, from, to] :
+       {std::tuple{"dallara", "home", "patch"}, std::tuple{"dlr", "patch", "mould"}}) {
+    SCOPED_TRACE(cell);
+    const std::string name = std::string(cell) + "-" + from + "-" + to;
+    const json before = read_json(std::string(LEEWAY_TEST_DATA_DIR) + "/thesis_bounds/" + name + ".json");
+    const std::string out = file(name + ".json");
+    const auto r = run_cli("bounds " + workcell(cell) + " --from " + from + " --to " + to +
+                           " --max-cells 2000 --preset thesis --out " + out);
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    const json now = read_json(out);
+    EXPECT_EQ(now.at("safety").at("mode"), "none");
+    EXPECT_EQ(intervals(now), intervals(before));
+    EXPECT_EQ(now.at("boxes"), before.at("boxes"));
+    // --safety none over the thesis preset's parameters is the same thing.
+    const auto n = run_cli("bounds " + workcell(cell) + " --from " + from + " --to " + to +
+                           " --max-cells 2000 --preset thesis --safety none --out " + out);
+    ASSERT_EQ(n.exit_code, 0) << n.out;
+    EXPECT_EQ(intervals(read_json(out)), intervals(before));
+  }
+}
+
+// `leeway params --preset P` written to a file and given back with --params (over the other preset)
+// gives the same bounds as --preset P.
+TEST_F(CliSafetyTest, PresetsRoundTripThroughParams) {
+  const std::string cell = workcell("baltico");
+  for (const auto& [preset, other] : {std::pair{"leeway", "thesis"}, std::pair{"thesis", "leeway"}}) {
+    SCOPED_TRACE(preset);
+    const auto p = run_cli(std::string("params --preset ") + preset);
+    ASSERT_EQ(p.exit_code, 0) << p.out;
+    const std::string params = dir_.write(std::string(preset) + ".params.json", p.out);
+    const std::string a = file("a.json"), b = file("b.json");
+    ASSERT_EQ(
+        run_cli("bounds " + cell + " --from mould --to home --preset " + preset + " --out " + a).exit_code,
+        0);
+    ASSERT_EQ(run_cli("bounds " + cell + " --from mould --to home --preset " + other + " --params " + params +
+                      " --out " + b)
+                  .exit_code,
+              0);
+    EXPECT_EQ(intervals(read_json(a)), intervals(read_json(b)));
+    EXPECT_EQ(read_json(a).at("params"), read_json(b).at("params"));
+  }
+  EXPECT_EQ(run_cli("params --preset nonsense").exit_code, 2);
+  const auto bad = run_cli("bounds " + cell + " --from mould --to home --safety maybe");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_THAT(bad.out, HasSubstr("--safety 'maybe' must be certified, sampled or none"));
+}
+
+TEST_F(CliSafetyTest, SampledModeStatesEpsilonDeltaAndN) {
+  const std::string out = file("s.json");
+  const auto r =
+      run_cli("bounds " + workcell("baltico") + " --from mould --to home --safety sampled --out " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_THAT(r.out, HasSubstr("29958 collision-free samples (epsilon 0.0001, delta 0.05)"));
+  const json s = read_json(out).at("safety");
+  EXPECT_EQ(s.at("mode"), "sampled");
+  EXPECT_EQ(s.at("epsilon").get<double>(), 1e-4);
+  EXPECT_EQ(s.at("delta").get<double>(), 0.05);
+  EXPECT_EQ(s.at("samples_per_segment").get<long>(), 29958);
+  EXPECT_TRUE(s.at("passed").get<bool>());
+}
+
+}  // namespace
+}  // namespace leeway

@@ -71,6 +71,9 @@ TuningCase::TuningCase(const CaseSpec& spec, const nlohmann::json& base_json, in
         throw InputError("the path leaves the limits of joint '" +
                          scene_->joints()[static_cast<size_t>(outside.front())].name + "'");
     }
+    // leeway-tune tunes the guide, Algorithms 2 and 3 against the volume, as published: no safety
+    // stage unless the base parameters ask for one.
+    params_.safety.mode = SafetyMode::kNone;
     apply_cell_defaults(*scene_, params_);
     if (!base_json.is_null()) params_ = params_from_json(base_json, "the base parameters", params_);
     params_.validate();

@@ -6,9 +6,10 @@ Usage: tools/make_results.py [--leeway build/leeway] [--samples 10000] [--out do
                              [--render-only]
 The sweeps' CSV files are kept in docs/data/results/ (with the machine line); --render-only
 rebuilds docs/results.md from them without running anything.
-Runs `leeway sweep` for every (cell, path) in two configurations: the thesis's parameters
-(section 4.1, with each cell's own reach radius and the DLR obstacle-box option) and the same with
-volume.trail_margin = 0.1 m. Takes several minutes on 2 cores.
+Runs `leeway sweep --preset thesis` (no safety stage: the published method) for every (cell, path)
+in two configurations: the thesis's parameters (section 4.1, with each cell's own reach radius and
+the DLR obstacle-box option) and the same with volume.trail_margin = 0.1 m. Takes several minutes
+on 2 cores. The section on the safety stage comes from tools/make_safety_results.py.
 """
 import argparse
 import csv
@@ -51,7 +52,7 @@ def sweep(leeway, cell, src, dst, name, params, samples, tmp):
     pfile.write_text(json.dumps(params))
     out = DATA / f"{cell}-{src}-{dst}-{name}.csv"
     cmd = [leeway, "sweep", str(ROOT / "mjcf" / "workcells" / f"{cell}.xml"), "--from", src, "--to", dst,
-           "--samples", str(samples), "--csv", str(out), "--params", str(pfile)]
+           "--samples", str(samples), "--csv", str(out), "--preset", "thesis", "--params", str(pfile)]
     subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     return read_csv(out)
 
@@ -119,6 +120,10 @@ def main():
         o.append(f"| leeway, {name} | {r['boxes']} | {float(r['time_ms']):.0f} | {100 * float(r['cf']):.4f} | "
                  f"{r['collapsed']}/6 | {float(r['mean_width']):.3f} |")
     o.append("")
+    # The safety stage against the thesis's method: tools/make_safety_results.py writes this section.
+    safety = ROOT / "docs" / "data" / "safety" / "section.md"
+    if safety.exists():
+        o.append(safety.read_text())
     for cell, src, dst, table in PATHS:
         o.append(f"## {cell.capitalize() if cell != 'dlr' else 'DLR'} {src}-{dst} (thesis table {table})\n")
         o.append("| Max CBox | thesis CBox | thesis ms | thesis CF | CBox | ms | CF | 95 % CI | worst window | "

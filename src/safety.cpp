@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <random>
 
 #include "leeway/error.hpp"
 #include "leeway/kinematics.hpp"
+#include "parallel.hpp"
 
 namespace leeway {
 namespace {
@@ -55,11 +57,12 @@ double unit(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x
 // on its side of the nominal value, at the end(s) of the segment that weigh most at its path
 // parameter (then at both ends; when that extent is already zero, every extent). Regrow: every
 // shrunk extent is then bisected back toward its guide value, first against the probe (cheap),
-// then against the certificate (kRegrowSteps steps), for this segment and for the previous one,
-// which shares waypoint a. `guide` holds the extents before the safety stage. A segment that cannot
+// then against the certificate (kRegrowSteps steps), for this segment and for the neighbouring
+// segments that share the regrown waypoint and are already certified (`check_previous`,
+// `check_next`). `guide` holds the extents before the safety stage. A segment that cannot
 // be certified keeps only its nominal values.
 SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& guide, size_t a, size_t b,
-                              bool has_previous, CertifyStats& total) {
+                              bool check_previous, bool check_next, CertifyStats& total) {
   SegmentSafety s;
   CertifyStats stats;
   const int n = static_cast<int>(e.q[a].size());
@@ -128,33 +131,38 @@ SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& g
   if (s.passed && s.shrink_steps > 0) {
     std::vector<size_t> ends = {a};
     if (b != a) ends.push_back(b);
-    const bool check_previous = has_previous;
     for (int i = 0; i < n; ++i)
       for (size_t k : ends)
         for (int side = 0; side < 2; ++side) {
           double& extent = side ? e.above[k][i] : e.below[k][i];
           const double shrunk_to = extent, guide_extent = side ? guide.above[k][i] : guide.below[k][i];
           if (!(guide_extent > shrunk_to)) continue;
-          const bool previous = check_previous && k == a;
+          const bool previous = check_previous && k == a, next = check_next && k == b && a != b;
           // The largest extent the probe does not reject, by bisection (cheap) ...
           double ok = shrunk_to, bad = guide_extent;
           extent = bad;
-          if (probed(a, b, nullptr) && (!previous || probed(a - 1, a, nullptr))) {
+          auto probe_all = [&] {
+            return probed(a, b, nullptr) && (!previous || probed(a - 1, a, nullptr)) &&
+                   (!next || probed(b, b + 1, nullptr));
+          };
+          if (probe_all()) {
             ok = bad;
           } else {
             for (int step = 0; step < kProbeSteps; ++step) {
               extent = (ok + bad) / 2;
-              const bool pass = probed(a, b, nullptr) && (!previous || probed(a - 1, a, nullptr));
+              const bool pass = probe_all();
               (pass ? ok : bad) = extent;
             }
           }
-          // ... then the largest the certificate proves, between the shrunk value and that one.
+          // ... then the largest the certificate proves, between the shrunk value and that one
+          // (the probe's limit first).
           const double probe_limit = ok;
           ok = shrunk_to;
           bad = probe_limit;
           for (int step = 0; step < kRegrowSteps && bad - ok > kTinyExtent; ++step) {
             extent = step == 0 ? bad : (ok + bad) / 2;
-            const bool pass = certified(a, b, nullptr) && (!previous || certified(a - 1, a, nullptr));
+            const bool pass = certified(a, b, nullptr) && (!previous || certified(a - 1, a, nullptr)) &&
+                              (!next || certified(b, b + 1, nullptr));
             if (pass) {
               ok = extent;
               if (step == 0) break;
@@ -220,7 +228,7 @@ long sampled_test_size(double epsilon, double delta) {
 }
 
 SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, const SafetyParams& params,
-                       CertifyBound bound) {
+                       CertifyBound bound, int threads) {
   SafetyReport report;
   report.mode = params.mode;
   if (params.mode == SafetyMode::kNone || bounds.empty()) return report;
@@ -240,11 +248,28 @@ SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, 
     options.margin = params.margin;
     options.max_leaves = params.max_leaves;
     options.bound = bound;
-    Certifier certifier(scene, options);
     const Extents guide(bounds);
-    for (size_t s = 0; s < segments; ++s)
-      report.segments.push_back(
-          certify_segment(certifier, e, guide, s, std::min(s + 1, bounds.size() - 1), s > 0, report.stats));
+    // Segment s writes waypoints s and s + 1 and, regrowing them, reads its neighbours' (s - 1 and
+    // s + 2): segments three apart share nothing, so the segments with s % 3 == phase run in
+    // parallel, phase by phase. A regrown waypoint must keep the neighbour that shares it certified
+    // when that neighbour's phase came earlier. The order does not depend on the thread count.
+    report.segments.assign(segments, SegmentSafety{});
+    std::vector<CertifyStats> stats(segments);
+    for (size_t phase = 0; phase < 3; ++phase) {
+      std::vector<size_t> jobs;
+      for (size_t s = phase; s < segments; s += 3) jobs.push_back(s);
+      detail::parallel_for(static_cast<int>(jobs.size()), threads, [&] {
+        auto certifier = std::make_shared<Certifier>(scene, options);
+        return [&, certifier](int i) {
+          const size_t s = jobs[static_cast<size_t>(i)];
+          const bool previous = s > 0 && phase > 0;
+          const bool next = s + 1 < segments && phase == 2;
+          report.segments[s] = certify_segment(*certifier, e, guide, s, std::min(s + 1, bounds.size() - 1),
+                                               previous, next, stats[s]);
+        };
+      });
+    }
+    for (const auto& st : stats) report.stats.add(st);
   } else {
     report.samples_per_segment = sampled_test_size(params.epsilon, params.delta);
     RobotState state(scene);

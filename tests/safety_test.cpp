@@ -229,6 +229,20 @@ TEST_F(CliSafetyTest, PresetsRoundTripThroughParams) {
   EXPECT_THAT(bad.out, HasSubstr("--safety 'maybe' must be certified, sampled or none"));
 }
 
+// Five waypoints, four segments: segments 0 and 3 are certified in parallel with two threads. The
+// bounds must not depend on it, and every segment must be certified.
+TEST_F(CliSafetyTest, SameCertifiedBoundsForOneAndTwoThreads) {
+  const std::string a = file("t1.json"), b = file("t2.json");
+  const std::string common = "bounds " + workcell("dallara") + " --from mould --to home --waypoints 5 --out ";
+  ASSERT_EQ(run_cli(common + a + " --threads 1").exit_code, 0);
+  ASSERT_EQ(run_cli(common + b + " --threads 2").exit_code, 0);
+  const json ja = read_json(a), jb = read_json(b);
+  EXPECT_EQ(intervals(ja), intervals(jb));
+  ASSERT_EQ(ja.at("safety").at("segments").size(), 4u);
+  for (const auto& s : ja.at("safety").at("segments")) EXPECT_TRUE(s.at("passed").get<bool>());
+  EXPECT_EQ(ja.at("safety").at("leaves"), jb.at("safety").at("leaves"));
+}
+
 TEST_F(CliSafetyTest, SampledModeStatesEpsilonDeltaAndN) {
   const std::string out = file("s.json");
   const auto r =

@@ -44,8 +44,9 @@ long sampled_test_size(double epsilon, double delta);
 //! is certified; sampled until every segment passes the sampling test. Bounds never shrink below the
 //! nominal value. Deterministic. @throws InputError on bounds that do not fit the scene.
 //! `bound` selects the certificate's bound (the loose lever-arm bound is kept as a reference for tests
-//! and the benchmark).
+//! and the benchmark). Certified mode runs segments three apart in parallel on `threads` threads;
+//! the result does not depend on the thread count.
 SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, const SafetyParams& params,
-                       CertifyBound bound = CertifyBound::kTaylor);
+                       CertifyBound bound = CertifyBound::kTaylor, int threads = 1);
 
 }  // namespace leeway

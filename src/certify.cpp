@@ -72,12 +72,21 @@ Certifier::Certifier(const Scene& scene, CertifyOptions options)
       const int r = robot_index[static_cast<size_t>(jid)];
       LEEWAY_DEMAND(r >= 0);  // the scene recognises every joint on a link's chain as a robot joint
       link.joints.push_back(r);
-      // Bound of |x - o_j| over every configuration, by the triangle inequality over the fixed
-      // offsets of the chain: the anchor's offset in its body, every later body's position in its
-      // parent, the shift of a body's origin by its own joints (at most twice their anchor
-      // offsets) and the geom's position in its body. Rotations keep lengths.
+      // Bound of |x - o_j| over every configuration, by the triangle inequality over the offsets of
+      // the chain: the anchor's offset in its body, every later body's position in its parent, the
+      // shift of a body's origin by its own joints (a later hinge: at most twice its anchor offset;
+      // a later slide: its longest travel from the reference position within its limits) and the
+      // geom's position in its body. Rotations keep lengths.
       double lever = vec3(m.jnt_pos + 3 * jid).norm();
-      for (size_t q = p + 1; q < jids.size(); ++q) lever += 2 * vec3(m.jnt_pos + 3 * jids[q]).norm();
+      for (size_t q = p + 1; q < jids.size(); ++q) {
+        const int later = jids[q];
+        lever += 2 * vec3(m.jnt_pos + 3 * later).norm();
+        if (m.jnt_type[later] == mjJNT_SLIDE) {
+          const double ref = m.qpos0[m.jnt_qposadr[later]];
+          const auto& joint = scene.joints()[static_cast<size_t>(robot_index[static_cast<size_t>(later)])];
+          lever += std::max(std::abs(joint.lower - ref), std::abs(joint.upper - ref));
+        }
+      }
       for (size_t k = body_of_joint[p] + 1; k < bodies.size(); ++k)
         lever += vec3(m.body_pos + 3 * bodies[k]).norm();
       lever += vec3(m.geom_pos + 3 * g).norm();
@@ -485,6 +494,8 @@ bool Certifier::segment_probe(const Eigen::VectorXd& lower_a, const Eigen::Vecto
                               const Eigen::VectorXd& lower_b, const Eigen::VectorXd& upper_b,
                               const Eigen::VectorXd& qa, const Eigen::VectorXd& qb, int samples,
                               CertifyStats& stats, CertifyFailure* failure) {
+  check_box(*scene_, qa, qa);
+  check_box(*scene_, qb, qb);
   check_box(*scene_, lower_a, upper_a);
   check_box(*scene_, lower_b, upper_b);
   CertifyFailure local;
@@ -543,7 +554,9 @@ bool Certifier::segment_free(const Eigen::VectorXd& lower_a, const Eigen::Vector
     // the hull of a long diagonal stretch is mostly empty space that no configuration visits.
     const Eigen::VectorXd motion = ((lo1 + hi1) - (lo0 + hi0)).cwiseAbs() / 2;
     const Eigen::VectorXd half = ((hi0 - lo0).cwiseMin(hi1 - lo1)) / 2;
-    const bool dominated = ((motion.array() > 0.5 * half.array()) && (motion.array() > 1e-9)).any();
+    // (An absolute floor keeps zero-width bounds, whose box is the path's own motion, from being
+    // split without end: 5 mrad or 5 mm of motion is left to the box.)
+    const bool dominated = (motion.array() > 0.5 * half.array() + 0.005).any();
     if (splittable && dominated) {
       const double tm = (t0 + t1) / 2;
       stack.push_back({tm, t1});
@@ -563,7 +576,7 @@ bool Certifier::segment_free(const Eigen::VectorXd& lower_a, const Eigen::Vector
     }
     // Joint splits within a share of the remaining budget; when they do not suffice, a shorter
     // stretch of the path may.
-    const bool worth_splitting = ((motion.array() > 0.05 * half.array()) && (motion.array() > 1e-9)).any();
+    const bool worth_splitting = (motion.array() > 0.05 * half.array() + 1e-4).any();
     const long share = splittable && worth_splitting ? std::max(64L, remaining / 16) : remaining;
     CertifyFailure local;
     if (region_free_impl(lo, hi, stats, &local, std::min(share, remaining))) continue;

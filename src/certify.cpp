@@ -536,15 +536,23 @@ bool Certifier::region_free(const Eigen::VectorXd& lower, const Eigen::VectorXd&
 
 bool Certifier::segment_free(const Eigen::VectorXd& lower_a, const Eigen::VectorXd& upper_a,
                              const Eigen::VectorXd& lower_b, const Eigen::VectorXd& upper_b,
-                             CertifyStats& stats, CertifyFailure* failure) {
+                             CertifyStats& stats, CertifyFailure* failure,
+                             std::vector<std::pair<double, double>>* proven) {
   check_box(*scene_, lower_a, upper_a);
   check_box(*scene_, lower_b, upper_b);
   constexpr double kMinDt = 1.0 / (1 << 20);
   const long start = stats.leaves;
   std::vector<std::pair<double, double>> stack = {{0.0, 1.0}};
+  auto known = [&](double t0, double t1) {
+    if (!proven) return false;
+    for (const auto& [p0, p1] : *proven)
+      if (p0 <= t0 && t1 <= p1) return true;
+    return false;
+  };
   while (!stack.empty()) {
     const auto [t0, t1] = stack.back();
     stack.pop_back();
+    if (known(t0, t1)) continue;  // a superset of this stretch was proven before
     const Eigen::VectorXd lo0 = (1 - t0) * lower_a + t0 * lower_b, lo1 = (1 - t1) * lower_a + t1 * lower_b;
     const Eigen::VectorXd hi0 = (1 - t0) * upper_a + t0 * upper_b, hi1 = (1 - t1) * upper_a + t1 * upper_b;
     // lower(t) and upper(t) are linear in t: over [t0, t1] they stay within their end values.
@@ -579,7 +587,10 @@ bool Certifier::segment_free(const Eigen::VectorXd& lower_a, const Eigen::Vector
     const bool worth_splitting = (motion.array() > 0.05 * half.array() + 1e-4).any();
     const long share = splittable && worth_splitting ? std::max(64L, remaining / 16) : remaining;
     CertifyFailure local;
-    if (region_free_impl(lo, hi, stats, &local, std::min(share, remaining))) continue;
+    if (region_free_impl(lo, hi, stats, &local, std::min(share, remaining))) {
+      if (proven) proven->emplace_back(t0, t1);
+      continue;
+    }
     // Not proven: is there a colliding configuration in the region itself (the boxes at t0, t1)?
     const Eigen::VectorXd q0 = (lo0 + hi0) / 2, q1 = (lo1 + hi1) / 2;
     for (int end = 0; end < 2 && !local.centre_hits; ++end) {

@@ -21,8 +21,9 @@ constexpr int kMaxShrinkSteps = 400;
 // the certificate (its first step tries the probe's limit itself).
 constexpr int kProbeSteps = 6;
 constexpr int kRegrowSteps = 4;
-// A shrink-phase test that ran out of leaves is tried once more with this many times the budget.
-constexpr long kEscalate = 1;
+// A slab (what one regrow step adds) gets this fraction of the leaf budget: a slab that needs more
+// is not worth its cost.
+constexpr long kSlabBudgetDivisor = 4;
 // Random configurations a probe checks besides the corners.
 constexpr int kProbeSamples = 200;
 
@@ -57,7 +58,8 @@ double unit(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x
 // on its side of the nominal value, at the end(s) of the segment that weigh most at its path
 // parameter (then at both ends; when that extent is already zero, every extent). Regrow: every
 // shrunk extent is then bisected back toward its guide value, first against the probe (cheap),
-// then against the certificate (kRegrowSteps steps), for this segment and for the neighbouring
+// then against the certificate (kRegrowSteps steps, each proving only the slab the growth adds),
+// for this segment and for the neighbouring
 // segments that share the regrown waypoint and are already certified (`check_previous`,
 // `check_next`). `guide` holds the extents before the safety stage. A segment that cannot
 // be certified keeps only its nominal values.
@@ -66,8 +68,10 @@ SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& g
   SegmentSafety s;
   CertifyStats stats;
   const int n = static_cast<int>(e.q[a].size());
+  // Stretches of this segment proven free so far: valid while its bounds only shrink.
+  std::vector<std::pair<double, double>> proven;
   auto certified = [&](size_t from, size_t to, CertifyFailure* f) {
-    return certifier.segment_free(e.lower(from), e.upper(from), e.lower(to), e.upper(to), stats, f);
+    return certifier.segment_free(e.lower(from), e.upper(from), e.lower(to), e.upper(to), stats, f, &proven);
   };
   auto probed = [&](size_t from, size_t to, CertifyFailure* f) {
     return certifier.segment_probe(e.lower(from), e.upper(from), e.lower(to), e.upper(to), e.q[from], e.q[to],
@@ -106,19 +110,6 @@ SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& g
       s.passed = true;
       break;
     }
-    if (f.budget && !f.centre_hits && kEscalate > 1) {
-      // Out of leaves, not a collision: one more try with a larger budget before giving up width.
-      const CertifyOptions normal = certifier.options();
-      CertifyOptions more = normal;
-      more.max_leaves = normal.max_leaves * kEscalate;
-      certifier.set_options(more);
-      const bool pass = certified(a, b, &f);
-      certifier.set_options(normal);
-      if (pass) {
-        s.passed = true;
-        break;
-      }
-    }
     ++s.shrink_steps;
     if (!shrink_for(f)) break;  // nothing left to shrink: the nominal segment itself is not certified
   }
@@ -128,6 +119,32 @@ SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& g
       e.above[k].setZero();
     }
   }
+  // Growing one extent (waypoint k, joint i, side) from `from` to `to` adds to a certified segment
+  // (p, r), k one of its ends, exactly the configurations whose joint i lies between the old and the
+  // new bound: at each t a box, linear in t between the two ends (at the end other than k the
+  // slab has zero width). That slab is itself a segment for the certificate, and a thin one.
+  auto slab_certified = [&](size_t p, size_t r, size_t k, int i, int side, double from, double to) {
+    std::vector<Eigen::VectorXd> lo = {e.lower(p), e.lower(r)}, hi = {e.upper(p), e.upper(r)};
+    for (size_t end = 0; end < 2; ++end) {
+      const size_t x = end ? r : p;
+      const double now = side ? e.above[x][i] : e.below[x][i];
+      const double old_extent = x == k ? from : now, new_extent = x == k ? to : now;
+      if (side) {
+        lo[end][i] = e.q[x][i] + old_extent;
+        hi[end][i] = e.q[x][i] + new_extent;
+      } else {
+        lo[end][i] = e.q[x][i] - new_extent;
+        hi[end][i] = e.q[x][i] - old_extent;
+      }
+    }
+    const CertifyOptions normal = certifier.options();
+    CertifyOptions thin = normal;
+    thin.max_leaves = std::max(64L, normal.max_leaves / kSlabBudgetDivisor);
+    certifier.set_options(thin);
+    const bool free = certifier.segment_free(lo[0], hi[0], lo[1], hi[1], stats, nullptr);
+    certifier.set_options(normal);
+    return free;
+  };
   if (s.passed && s.shrink_steps > 0) {
     std::vector<size_t> ends = {a};
     if (b != a) ends.push_back(b);
@@ -161,8 +178,10 @@ SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& g
           bad = probe_limit;
           for (int step = 0; step < kRegrowSteps && bad - ok > kTinyExtent; ++step) {
             extent = step == 0 ? bad : (ok + bad) / 2;
-            const bool pass = certified(a, b, nullptr) && (!previous || certified(a - 1, a, nullptr)) &&
-                              (!next || certified(b, b + 1, nullptr));
+            // Only what the growth adds needs proving: the rest was proven with extent `ok`.
+            const bool pass = slab_certified(a, b, k, i, side, ok, extent) &&
+                              (!previous || slab_certified(a - 1, a, k, i, side, ok, extent)) &&
+                              (!next || slab_certified(b, b + 1, k, i, side, ok, extent));
             if (pass) {
               ok = extent;
               if (step == 0) break;

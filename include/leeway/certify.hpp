@@ -73,9 +73,14 @@ class Certifier {
   //! [0, 1] the joints range over [(1-t) lower_a + t lower_b, (1-t) upper_a + t upper_b] (the
   //! region leeway cf samples). [0, 1] is covered by sub-intervals, each enclosed by the box spanned
   //! by its end bounds, split where needed; one leaf budget for the whole segment.
+  //! `proven` (optional) carries stretches [t0, t1] of the path parameter already proven free for
+  //! bounds that contained these at every t (an earlier call before the bounds shrank): they are
+  //! skipped, and the stretches this call proves are appended. The caller keeps it only while the
+  //! bounds shrink.
   bool segment_free(const Eigen::VectorXd& lower_a, const Eigen::VectorXd& upper_a,
                     const Eigen::VectorXd& lower_b, const Eigen::VectorXd& upper_b, CertifyStats& stats,
-                    CertifyFailure* failure = nullptr);
+                    CertifyFailure* failure = nullptr,
+                    std::vector<std::pair<double, double>>* proven = nullptr);
 
   //! A quick necessary test, not a proof: exact checks (the margin included) of the corners and
   //! centre of the bounds at t = 0, 1/4, 1/2, 3/4, 1 and of `samples` random configurations of the

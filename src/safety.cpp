@@ -9,6 +9,7 @@
 #include "leeway/error.hpp"
 #include "leeway/kinematics.hpp"
 #include "parallel.hpp"
+#include "random.hpp"
 
 namespace leeway {
 namespace {
@@ -43,14 +44,8 @@ struct Extents {
 
 void halve(double& extent) { extent = extent / 2 < kTinyExtent ? 0.0 : extent / 2; }
 
-std::uint64_t splitmix(std::uint64_t x) {
-  x += 0x9E3779B97F4A7C15ULL;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
-  return x ^ (x >> 31);
-}
-
-double unit(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+using detail::splitmix;
+using detail::unit;
 
 // Certified mode for the segment between waypoints a and b (a == b for a one-waypoint path).
 // Shrink: while a quick probe (exact checks of corners and samples) finds a configuration too close

@@ -257,15 +257,28 @@ std::string cell_path(const test::TempDir& dir, const std::string& name) {
   return workcell(name);
 }
 
-class CertifyPropertyTest : public ::testing::TestWithParam<const char*> {
+// One cell per instance; each test draws its regions from its own stream (`salt`).
+class CertifyPropertyTest : public test::MujocoTestOf<::testing::TestWithParam<const char*>> {
  protected:
   void SetUp() override {
-    install_mujoco_handlers();
-    take_mujoco_warnings();
+    MujocoTestOf::SetUp();
+    cell_ = GetParam();
+    seed_ = property_seed();
+    scene_ = std::make_unique<Scene>(Scene::load(cell_path(dir_, cell_)));
   }
-  void TearDown() override {
-    for (const auto& w : take_mujoco_warnings()) ADD_FAILURE() << "MuJoCo warning: " << w;
+  //! The region source of one test.
+  RegionSource source(std::uint64_t multiplier, std::uint64_t salt) const {
+    return RegionSource(*scene_, seed_ * multiplier + std::hash<std::string>()(cell_) + salt);
   }
+  //! How many regions a test draws: the small test cells get more, `divisor` scales it down.
+  int count(int divisor) const {
+    return property_count(cell_ == "one_link" || cell_ == "hammer" ? 1500 : 400) / divisor;
+  }
+  std::string trace() const { return "LEEWAY_CERTIFY_SEED=" + std::to_string(seed_) + ", cell " + cell_; }
+  std::string cell_;
+  std::uint64_t seed_ = 0;
+  test::TempDir dir_;
+  std::unique_ptr<Scene> scene_;
 };
 
 const double kMargins[] = {0.001, 0.001, 0.01, 0.05};
@@ -274,18 +287,15 @@ const double kMargins[] = {0.001, 0.001, 0.01, 0.05};
 // the margin to an obstacle. A small leaf budget keeps it fast; the count of certified regions
 // (and of those that came within 5 cm of the margin) shows that it is not vacuous.
 TEST_P(CertifyPropertyTest, CertifiedRegionsAreFree) {
-  const std::string cell = GetParam();
-  const std::uint64_t seed = property_seed();
-  SCOPED_TRACE("LEEWAY_CERTIFY_SEED=" + std::to_string(seed) + ", cell " + cell);
-  test::TempDir dir;
-  const Scene scene = Scene::load(cell_path(dir, cell));
-  RegionSource src(scene, seed * 1000003u + std::hash<std::string>()(cell));
+  SCOPED_TRACE(trace());
+  const std::string& cell = cell_;
+  const Scene& scene = *scene_;
+  RegionSource src = source(1000003u, 0);
   RobotState state(scene);
   CertifyOptions opt;
   opt.max_leaves = 256;
   Certifier certifier(scene, opt);
-  const int count =
-      property_count(cell == std::string("one_link") || cell == std::string("hammer") ? 1500 : 400);
+  const int count = this->count(1);
   int certified = 0, close = 0, failures = 0;
   long leaves = 0;
   for (int r = 0; r < count && failures < 3; ++r) {
@@ -318,18 +328,15 @@ TEST_P(CertifyPropertyTest, CertifiedRegionsAreFree) {
 // any term that is too small shows as a sample within the margin. (With the remainder dropped from
 // the Taylor bound this test fails on baltico and on the hammer cell; the other two miss it.)
 TEST_P(CertifyPropertyTest, LargestCertifiedBoxesAreFree) {
-  const std::string cell = GetParam();
-  const std::uint64_t seed = property_seed();
-  SCOPED_TRACE("LEEWAY_CERTIFY_SEED=" + std::to_string(seed) + ", cell " + cell);
-  test::TempDir dir;
-  const Scene scene = Scene::load(cell_path(dir, cell));
-  RegionSource src(scene, seed * 998001u + std::hash<std::string>()(cell) + 2);
+  SCOPED_TRACE(trace());
+  const std::string& cell = cell_;
+  const Scene& scene = *scene_;
+  RegionSource src = source(998001u, 2);
   RobotState state(scene);
   CertifyOptions opt;
   opt.max_leaves = 64;
   Certifier certifier(scene, opt);
-  const int count =
-      property_count(cell == std::string("one_link") || cell == std::string("hammer") ? 1500 : 400) / 4;
+  const int count = this->count(4);
   int boxes = 0, close = 0, failures = 0;
   for (int r = 0; r < count && failures < 3; ++r) {
     const Eigen::VectorXd c = src.centre(1 + r % 2);
@@ -371,18 +378,15 @@ TEST_P(CertifyPropertyTest, LargestCertifiedBoxesAreFree) {
 // The same for segment_free: two random boxes (the second centred up to 0.3 rad or m per joint
 // away from the first), sampled as leeway cf samples the segment between them.
 TEST_P(CertifyPropertyTest, CertifiedSegmentsAreFree) {
-  const std::string cell = GetParam();
-  const std::uint64_t seed = property_seed();
-  SCOPED_TRACE("LEEWAY_CERTIFY_SEED=" + std::to_string(seed) + ", cell " + cell);
-  test::TempDir dir;
-  const Scene scene = Scene::load(cell_path(dir, cell));
-  RegionSource src(scene, seed * 999983u + std::hash<std::string>()(cell) + 1);
+  SCOPED_TRACE(trace());
+  const std::string& cell = cell_;
+  const Scene& scene = *scene_;
+  RegionSource src = source(999983u, 1);
   RobotState state(scene);
   CertifyOptions opt;
   opt.max_leaves = 256;
   Certifier certifier(scene, opt);
-  const int count =
-      property_count(cell == std::string("one_link") || cell == std::string("hammer") ? 1500 : 400) / 2;
+  const int count = this->count(2);
   int certified = 0, close = 0, failures = 0;
   long leaves = 0;
   for (int r = 0; r < count && failures < 3; ++r) {

@@ -16,14 +16,10 @@ namespace leeway {
 namespace {
 
 using nlohmann::json;
+using test::read_json;
 using test::run_cli;
 using test::workcell;
 using ::testing::HasSubstr;
-
-json read_json(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  return json::parse(in);
-}
 
 // The one-link arm (test_util.hpp) with a wall along +y: `hit` touches it, `behind` lies beyond
 // it (no path from home), the site `far` is out of reach.
@@ -41,20 +37,7 @@ class CliPlanTest : public ::testing::Test {
   }
   // The Dallara cell with a wall across the straight path from home to patch (as in
   // planner_test.cpp): RRT-Connect has to find a detour.
-  std::string wall_cell() const {
-    std::filesystem::create_directories(dir_.path() / "cells");
-    if (!std::filesystem::exists(dir_.path() / "robots"))
-      std::filesystem::create_directory_symlink(std::string(LEEWAY_MJCF_DIR) + "/robots",
-                                                dir_.path() / "robots");
-    std::ifstream in(workcell("dallara"));
-    std::string xml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    xml.replace(
-        xml.find("</worldbody>"), 0,
-        R"(<geom name="wall" type="box" pos="1.151 -0.706 0.9" size="0.55 0.05 0.9" euler="0 0 -0.55")"
-        R"( contype="0" conaffinity="1"/>)"
-        "\n");
-    return dir_.write("cells/wall.xml", xml);
-  }
+  std::string wall_cell() const { return test::dallara_with_wall(dir_); }
   test::TempDir dir_;
 };
 

@@ -24,6 +24,7 @@ namespace leeway {
 namespace {
 
 using nlohmann::json;
+using test::read_json;
 using test::run_cli;
 using test::workcell;
 using ::testing::HasSubstr;
@@ -243,11 +244,6 @@ TEST_F(PathCheckTest, BadInputThrowsWithoutNamingFlags) {
 
 // ---- The command line ------------------------------------------------------------------------
 
-json read_json(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  return json::parse(in);
-}
-
 // The number after "s = " in a message (-1 when there is none).
 double s_in(const std::string& message) {
   std::smatch m;
@@ -259,21 +255,8 @@ class CliPathCheckTest : public ::testing::Test {
  protected:
   std::string file(const std::string& name) const { return (dir_.path() / name).string(); }
   std::string one_link() const { return dir_.write("one_link.xml", test::one_link_cell(kWall, kWallKeys)); }
-  // The Dallara cell with a wall across the straight path from home to patch (cli_plan_test.cpp).
-  std::string wall_cell() const {
-    std::filesystem::create_directories(dir_.path() / "cells");
-    if (!std::filesystem::exists(dir_.path() / "robots"))
-      std::filesystem::create_directory_symlink(std::string(LEEWAY_MJCF_DIR) + "/robots",
-                                                dir_.path() / "robots");
-    std::ifstream in(workcell("dallara"));
-    std::string xml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    xml.replace(
-        xml.find("</worldbody>"), 0,
-        R"(<geom name="wall" type="box" pos="1.151 -0.706 0.9" size="0.55 0.05 0.9" euler="0 0 -0.55")"
-        R"( contype="0" conaffinity="1"/>)"
-        "\n");
-    return dir_.write("cells/wall.xml", xml);
-  }
+  // The Dallara cell with a wall across the straight path from home to patch.
+  std::string wall_cell() const { return test::dallara_with_wall(dir_); }
   test::TempDir dir_;
 };
 

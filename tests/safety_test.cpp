@@ -18,14 +18,10 @@ namespace leeway {
 namespace {
 
 using nlohmann::json;
+using test::read_json;
 using test::run_cli;
 using test::workcell;
 using ::testing::HasSubstr;
-
-json read_json(const std::string& p) {
-  std::ifstream in(p);
-  return json::parse(in);
-}
 
 // The one-link arm of test_util.hpp (a 1 m link, half-height 0.05 m, rotating about z) with a wall
 // whose near face is the plane y = 0.95. The link's corner (1, 0.05) reaches it when

@@ -8,7 +8,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include <sys/wait.h>
@@ -67,8 +69,10 @@ inline std::string workcell(const std::string& name) {
   return std::string(LEEWAY_MJCF_DIR) + "/workcells/" + name + ".xml";
 }
 
-//! Fails the test on any MuJoCo warning raised on the test's thread.
-class MujocoTest : public ::testing::Test {
+//! Fails the test on any MuJoCo warning raised on the test's thread; `Base` is ::testing::Test or
+//! a ::testing::TestWithParam.
+template <class Base = ::testing::Test>
+class MujocoTestOf : public Base {
  protected:
   void SetUp() override {
     install_mujoco_handlers();
@@ -78,6 +82,29 @@ class MujocoTest : public ::testing::Test {
     for (const auto& w : take_mujoco_warnings()) ADD_FAILURE() << "MuJoCo warning: " << w;
   }
 };
+using MujocoTest = MujocoTestOf<>;
+
+//! The Dallara cell with a box wall across the joint-linear path from home to patch, written into
+//! `dir` (cells/wall.xml, with a link to the bundled robots so its include resolves).
+inline std::string dallara_with_wall(const TempDir& dir) {
+  std::filesystem::create_directories(dir.path() / "cells");
+  if (!std::filesystem::exists(dir.path() / "robots"))
+    std::filesystem::create_directory_symlink(std::string(LEEWAY_MJCF_DIR) + "/robots",
+                                              dir.path() / "robots");
+  std::ifstream in(workcell("dallara"));
+  std::string xml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  xml.replace(xml.find("</worldbody>"), 0,
+              R"(<geom name="wall" type="box" pos="1.151 -0.706 0.9" size="0.55 0.05 0.9" euler="0 0 -0.55")"
+              R"( contype="0" conaffinity="1"/>)"
+              "\n");
+  return dir.write("cells/wall.xml", xml);
+}
+
+//! Parses a JSON file.
+inline nlohmann::json read_json(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  return nlohmann::json::parse(in);
+}
 
 //! A one-link arm: hinge j1 about z at (0, 0, 0.5), a 1 m box link along +x (half-size
 //! 0.5 x 0.05 x 0.05), tool0 at its tip. `world` is inserted into the world body.

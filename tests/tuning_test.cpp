@@ -85,7 +85,7 @@ test::CliResult run_tune(const std::string& args) { return test::run_program(tun
 class TuningTest : public test::MujocoTest {
  protected:
   void SetUp() override {
-    MujocoTest::SetUp();
+    test::MujocoTest::SetUp();
     cell_ = dir_.write("cell.xml", test::one_link_cell(kTinyWorld, kTinyKeys));
     // Small maps keep every run in milliseconds; a 1.5 m reach fits the 1 m arm.
     base_ = dir_.write("base.json", R"({"height_map": {"max_cells": 500}, "volume": {"reach_radius": 1.5}})");

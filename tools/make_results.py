@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Regenerates docs/results.md: the nine thesis sweeps (tables 4.1-4.9) on leeway's rebuilt cells,
-beside the thesis's published figures (docs/data/thesis_tables.csv). Standard library only.
+beside the thesis's published tables (docs/data/thesis_tables.csv). Standard library only.
 
 Usage: tools/make_results.py [--leeway build/leeway] [--samples 10000] [--out docs/results.md]
                              [--render-only]
@@ -106,7 +106,8 @@ def main():
              "`volume.trail_margin` = 0.1 m (docs/algorithm.md). *collapsed* counts the bisected intervals "
              "(j1-j3 at 2 waypoints) that shrank to the nominal value and were widened by the guard; *width* is "
              "the mean width of the j1-j3 intervals in radians.\n")
-    o.append("Our cells are rebuilt from the thesis's text (docs/workcells.md), not its CAD models, and our "
+    o.append("Our cells are rebuilt from the thesis's text (docs/workcells.md): its figures are not available "
+             "to us, only their captions. Our "
              "height-map covers the reach circle's bounding square, so the box count at a given MAX_cells "
              "differs from the thesis's; compare rows by box count as well as by MAX_cells.\n")
     # Headline: the thesis's abstract, Dallara home-patch, MAX_cells 25000.

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <string>
 
 #include "leeway/error.hpp"
+#include "leeway/scene.hpp"
 #include "parallel.hpp"
 
 namespace leeway {
@@ -39,15 +41,54 @@ double bisect_towards(const CollisionFn& collides, Eigen::VectorXd q, int j, dou
   return a;
 }
 
+// The preconditions of bound_upper (upper = true) and bound_lower.
+void check_direction(const Eigen::VectorXd& q, int j, double limit, bool upper) {
+  if (j < 0 || j >= q.size())
+    throw InputError("joint index " + std::to_string(j) + " is outside a configuration of " +
+                     std::to_string(q.size()) + " joints");
+  if (upper ? !(limit >= q[j]) : !(limit <= q[j]))
+    throw InputError(std::string(upper ? "upper" : "lower") + " limit " + format_number(limit) +
+                     " of joint " + std::to_string(j) + " is " + (upper ? "below" : "above") + " its value " +
+                     format_number(q[j]));
+}
+
 }  // namespace
+
+WaypointBounds::WaypointBounds(Eigen::VectorXd q_in, Eigen::VectorXd lower_in, Eigen::VectorXd upper_in)
+    : q(std::move(q_in)), lower(std::move(lower_in)), upper(std::move(upper_in)) {
+  if (lower.size() != q.size() || upper.size() != q.size())
+    throw InputError("waypoint bounds: q has " + std::to_string(q.size()) + " values, lower " +
+                     std::to_string(lower.size()) + ", upper " + std::to_string(upper.size()));
+  for (Eigen::Index i = 0; i < q.size(); ++i) {
+    const std::string joint = "waypoint bounds: joint " + std::to_string(i);
+    if (!std::isfinite(q[i]) || !std::isfinite(lower[i]) || !std::isfinite(upper[i]))
+      throw InputError(joint + ": a value is not finite (q " + format_number(q[i]) + ", bounds [" +
+                       format_number(lower[i]) + ", " + format_number(upper[i]) + "])");
+    if (!(lower[i] <= q[i] && q[i] <= upper[i]))
+      throw InputError(joint + ": nominal " + format_number(q[i]) + " is not within [" +
+                       format_number(lower[i]) + ", " + format_number(upper[i]) + "]");
+  }
+  collapsed.assign(static_cast<size_t>(q.size()), false);
+  guide_lower = lower;
+  guide_upper = upper;
+}
+
+bool WaypointBounds::contains(const Eigen::VectorXd& c) const {
+  if (c.size() != lower.size() || c.size() != upper.size())
+    throw InputError("configuration of " + std::to_string(c.size()) + " values against waypoint bounds of " +
+                     std::to_string(lower.size()) + " joints");
+  return (lower.array() <= c.array()).all() && (c.array() <= upper.array()).all();
+}
 
 double bound_upper(const CollisionFn& collides, Eigen::VectorXd q, int j, double limit, double delta,
                    long& checks) {
+  check_direction(q, j, limit, true);
   return bisect_towards(collides, std::move(q), j, limit, delta, checks);
 }
 
 double bound_lower(const CollisionFn& collides, Eigen::VectorXd q, int j, double limit, double delta,
                    long& checks) {
+  check_direction(q, j, limit, false);
   return bisect_towards(collides, std::move(q), j, limit, delta, checks);
 }
 
@@ -84,7 +125,7 @@ WaypointBounds bound_waypoint(const Scene& scene, const CollisionFn& collides, c
     if (kinds[static_cast<size_t>(i)] == BoundKind::kBisected) {
       bisected.push_back(i);
     } else {
-      // The thesis leaves the wrist arbitrary (section 3.3) and gives the linear axis a fixed
+      // The thesis leaves the wrist arbitrary (section 3.3.1) and gives the linear axis a fixed
       // tolerance (section 4.2.3); both are fixed here, clamped to the limits.
       const double half = kinds[static_cast<size_t>(i)] == BoundKind::kFixed
                               ? params.wrist_half_width

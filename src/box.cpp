@@ -7,6 +7,17 @@
 #include <limits>
 
 namespace leeway {
+namespace {
+
+// box_distance alternates closest-point projections between the two convex boxes (von Neumann's
+// alternating projections), which converge to a closest pair. The run stops when the witnesses
+// move less than kProjectionTolerance [m] in one round (far below any collision margin), or after
+// kMaxProjectionRounds rounds as a guard: on boxes with parallel faces the convergence can be
+// linear but slow, and the last pair is still a valid upper bound of the distance.
+constexpr int kMaxProjectionRounds = 100000;
+constexpr double kProjectionTolerance = 1e-12;
+
+}  // namespace
 
 bool contains(const Box& box, const Eigen::Vector3d& p) {
   const Eigen::Vector3d local = box.rotation.transpose() * (p - box.center);
@@ -46,13 +57,13 @@ double box_distance(const Box& a, const Box& b, Eigen::Vector3d* on_a, Eigen::Ve
     if (on_b) *on_b = pb;
     return 0.0;
   }
-  for (int it = 0; it < 100000; ++it) {
+  for (int it = 0; it < kMaxProjectionRounds; ++it) {
     const Eigen::Vector3d na = closest_point(a, pb);
     const Eigen::Vector3d nb = closest_point(b, na);
     const double moved = (na - pa).norm() + (nb - pb).norm();
     pa = na;
     pb = nb;
-    if (moved < 1e-12) break;
+    if (moved < kProjectionTolerance) break;
   }
   if (on_a) *on_a = pa;
   if (on_b) *on_b = pb;
@@ -88,5 +99,7 @@ Box geom_box(const mjModel& m, const mjData& d, int geom) {
   }
   return b;
 }
+
+bool has_bounding_box(const mjModel& m, int geom) { return m.geom_type[geom] != mjGEOM_PLANE; }
 
 }  // namespace leeway

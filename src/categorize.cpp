@@ -54,7 +54,7 @@ Categories categorize(const Scene& scene, const std::vector<Eigen::VectorXd>& pa
   std::vector<int> ids;
   state.set(path.back());
   for (int g : obstacles) {
-    if (m.geom_type[g] == mjGEOM_PLANE) continue;
+    if (!has_bounding_box(m, g)) continue;  // the plane rule, box.hpp
     boxes.push_back(geom_box(m, state.data(), g));
     ids.push_back(g);
   }

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "json_io.hpp"
 #include "leeway/categorize.hpp"
 #include "leeway/error.hpp"
 
@@ -112,10 +113,17 @@ CheckReport check_scene(const Scene& scene, const CheckOptions& options) {
   }
 
   // Goal sites: Algorithm 1 and reach.
-  const std::vector<Box> boxes = obstacle_boxes(scene);
+  // Algorithm 1 over the obstacles with a bounding box, as categorize() searches (the plane rule,
+  // box.hpp): a collidable plane is reported above, not made every goal's obstacle.
+  std::vector<Box> boxes;
+  std::vector<int> box_geoms;
+  for (int g : obstacles)
+    if (has_bounding_box(m, g)) {
+      boxes.push_back(geom_box(m, *rest, g));
+      box_geoms.push_back(g);
+    }
   if (scene.goal_sites().empty()) report.warnings.push_back("the cell has no goal sites");
-  Eigen::VectorXd seed = (scene.lower_limits() + scene.upper_limits()) / 2;
-  if (!scene.keyframes().empty()) seed = scene.keyframes().front().q;
+  const Eigen::VectorXd seed = default_ik_seed(scene);
   for (int s : scene.goal_sites()) {
     GoalFindings g;
     g.site = object_name(m, mjOBJ_SITE, s);
@@ -123,7 +131,7 @@ CheckReport check_scene(const Scene& scene, const CheckOptions& options) {
     g.position = Eigen::Map<const Eigen::Vector3d>(rest->site_xpos + 3 * s);
     const auto found = find_goal_obstacle(g.position, boxes, options.goal_dz);
     if (found) {
-      g.goal_obstacle = obstacles[*found];
+      g.goal_obstacle = box_geoms[*found];
     } else {
       report.problems.push_back("goal site '" + g.site + "' at " + vec3(g.position) +
                                 " m: no obstacle lies below it (Algorithm 1), so it has no goal obstacle");
@@ -160,11 +168,7 @@ nlohmann::json to_json(const Scene& scene, const CheckReport& report) {
   using nlohmann::json;
   const mjModel& m = scene.model();
   auto v3 = [](const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); };
-  auto vec = [](const Eigen::VectorXd& v) {
-    json a = json::array();
-    for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v[i]);
-    return a;
-  };
+  const auto vec = detail::to_json_array;
   json out;
   out["file"] = scene.source();
   out["units"] = "SI: metres, radians";

@@ -8,13 +8,24 @@
 
 #include "leeway/box.hpp"
 #include "leeway/error.hpp"
+#include "random.hpp"
 
 namespace leeway {
 namespace {
 
-// Uniform double in [0, 1) from the raw 64-bit engine output: identical on every standard library
-// (std::uniform_real_distribution is not).
-double unit_uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+// Damped-least-squares (Levenberg-Marquardt) settings of solve_ik. The damping lambda adapts: it
+// shrinks after a step that lowers the residual and grows after one that does not, within
+// [kMinDamping, kMaxDamping]; the run stops when the damping is at its maximum and the step has
+// vanished (a local minimum).
+constexpr double kInitialDamping = 1e-2;  // lambda at every start
+constexpr double kMinDamping = 1e-4;      // floor: keeps J J^T + lambda^2 I well conditioned
+constexpr double kMaxDamping = 1.0;       // ceiling: at 1 the step is a short gradient step
+constexpr double kDampingDecrease = 0.5;  // lambda *= this after an accepted step
+constexpr double kDampingIncrease = 4.0;  // lambda *= this after a rejected step
+// Largest change of any joint in one iteration [rad or m]: the Jacobian is linear only nearby.
+constexpr double kMaxJointStep = 0.3;
+// A step this small [rad or m] with maximal damping means no further progress.
+constexpr double kStalledStep = 1e-9;
 
 Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
   Eigen::Matrix3d s;
@@ -25,7 +36,8 @@ Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
 }  // namespace
 
 RobotState::RobotState(const Scene& scene) : scene_(&scene), data_(make_data(scene.model())) {
-  install_mujoco_handlers();
+  // Idempotent; documented at install_mujoco_error_handlers(): MuJoCo must throw, not exit().
+  install_mujoco_error_handlers();
 }
 
 void RobotState::set(const Eigen::VectorXd& q) {
@@ -87,7 +99,7 @@ Clearance RobotState::clearance(const Eigen::VectorXd& q) {
   const mjModel& m = scene_->model();
   Clearance best;
   for (int o : scene_->obstacle_geoms()) {
-    if (m.geom_type[o] == mjGEOM_PLANE) continue;
+    if (!has_bounding_box(m, o)) continue;  // the plane rule, box.hpp
     const Box ob = geom_box(m, *data_, o);
     for (int l : scene_->link_geoms()) {
       const double dist = box_distance(geom_box(m, *data_, l), ob);
@@ -111,6 +123,11 @@ Eigen::MatrixXd RobotState::tool_jacobian() {
     }
   }
   return j;
+}
+
+Eigen::VectorXd default_ik_seed(const Scene& scene) {
+  if (!scene.keyframes().empty()) return scene.keyframes().front().q;
+  return Eigen::VectorXd::Zero(scene.dof()).cwiseMax(scene.lower_limits()).cwiseMin(scene.upper_limits());
 }
 
 IkResult solve_ik(RobotState& state, const Eigen::Vector3d& target, const Eigen::VectorXd& seed,
@@ -140,9 +157,9 @@ IkResult solve_ik(RobotState& state, const Eigen::Vector3d& target, const Eigen:
     Eigen::VectorXd q = seed.cwiseMax(lo).cwiseMin(hi);
     if (start > 0)
       for (int i = 0; i < n; ++i)
-        if (!locked[static_cast<size_t>(i)]) q[i] = lo[i] + (hi[i] - lo[i]) * unit_uniform(rng);
+        if (!locked[static_cast<size_t>(i)]) q[i] = lo[i] + (hi[i] - lo[i]) * detail::unit(rng);
     Eigen::VectorXd r;
-    double lambda = 1e-2;
+    double lambda = kInitialDamping;
     state.set(q);
     residual(r);
     for (int it = 0; it < options.max_iterations; ++it) {
@@ -160,7 +177,7 @@ IkResult solve_ik(RobotState& state, const Eigen::Vector3d& target, const Eigen:
           j * j.transpose() + lambda * lambda * Eigen::MatrixXd::Identity(r.size(), r.size());
       Eigen::VectorXd dq = -j.transpose() * a.ldlt().solve(r);
       const double step = dq.cwiseAbs().maxCoeff();
-      if (step > 0.3) dq *= 0.3 / step;
+      if (step > kMaxJointStep) dq *= kMaxJointStep / step;
       const Eigen::VectorXd q_new = (q + dq).cwiseMax(lo).cwiseMin(hi);
       state.set(q_new);
       Eigen::VectorXd r_new;
@@ -168,11 +185,11 @@ IkResult solve_ik(RobotState& state, const Eigen::Vector3d& target, const Eigen:
       if (r_new.norm() < r.norm()) {
         q = q_new;
         r = r_new;
-        lambda = std::max(1e-4, lambda * 0.5);
+        lambda = std::max(kMinDamping, lambda * kDampingDecrease);
       } else {
-        lambda = std::min(1.0, lambda * 4.0);
+        lambda = std::min(kMaxDamping, lambda * kDampingIncrease);
         state.set(q);
-        if (lambda >= 1.0 && step < 1e-9) break;
+        if (lambda >= kMaxDamping && step < kStalledStep) break;
       }
     }
     state.set(q);

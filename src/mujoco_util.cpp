@@ -20,7 +20,7 @@ void collect_warning(const char* msg) { t_warnings.emplace_back(msg); }
 
 }  // namespace
 
-void install_mujoco_handlers() {
+void install_mujoco_error_handlers() {
   static std::once_flag once;
   std::call_once(once, [] {
     mju_user_error = throw_on_error;
@@ -35,7 +35,8 @@ std::vector<std::string> take_mujoco_warnings() {
 }
 
 ModelPtr load_model_file(const std::string& path) {
-  install_mujoco_handlers();
+  // Documented in the header: without it a malformed file would make MuJoCo exit() the process.
+  install_mujoco_error_handlers();
   std::ifstream probe(path);
   if (!probe.good()) throw InputError(path + ": cannot open the file (missing or unreadable)");
   probe.close();

@@ -9,6 +9,7 @@
 #include <string>
 #include <type_traits>
 
+#include "json_io.hpp"
 #include "leeway/error.hpp"
 #include "leeway/scene.hpp"
 
@@ -159,7 +160,7 @@ void Params::validate() const {
     }
   });
   const HeightMapParams& hm = height_map;
-  require_between("height_map.max_cells", hm.max_cells, 1, 1000000);
+  require_between("height_map.max_cells", hm.max_cells, 1, kMaxCellsLimit);
   if (!hm.auto_extent) {
     // Explicit extents only matter (and are only checked) when auto_extent is off.
     if (!(hm.x_dim > 0))
@@ -295,18 +296,7 @@ Params params_from_json(const nlohmann::json& j, const std::string& source, cons
 }
 
 Params read_params(const std::string& path, const Params& base) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open the parameter file");
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::parse_error& e) {
-    std::string message = e.what();
-    for (char& ch : message)
-      if (ch == '\n' || ch == '\r') ch = ' ';
-    throw InputError(path + ": malformed JSON: " + message);
-  }
-  return params_from_json(j, path, base);
+  return params_from_json(detail::read_json_file(path, "parameter file"), path, base);
 }
 
 }  // namespace leeway

@@ -1,12 +1,14 @@
 #include "leeway/pipeline.hpp"
 
 #include <unistd.h>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 
+#include "json_io.hpp"
 #include "leeway/categorize.hpp"
 #include "leeway/error.hpp"
 
@@ -15,12 +17,6 @@ namespace {
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
-nlohmann::json vec(const Eigen::VectorXd& v) {
-  nlohmann::json a = nlohmann::json::array();
-  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v[i]);
-  return a;
 }
 
 }  // namespace
@@ -83,7 +79,9 @@ void apply_cell_defaults(const Scene& scene, Params& params) {
 
 std::vector<Eigen::VectorXd> keyframe_path(const Scene& scene, const std::string& from, const std::string& to,
                                            int waypoints) {
-  if (waypoints < 2) throw InputError("--waypoints " + std::to_string(waypoints) + " must be >= 2");
+  if (waypoints < 2)
+    throw InputError("path from keyframe '" + from + "' to '" + to + "': waypoint count " +
+                     std::to_string(waypoints) + " must be >= 2");
   const Eigen::VectorXd a = scene.keyframe(from).q, b = scene.keyframe(to).q;
   std::vector<Eigen::VectorXd> path;
   for (int i = 0; i < waypoints; ++i)
@@ -117,7 +115,7 @@ BoundsRun compute_bounds(const Scene& scene, VolumeModel& world, const std::vect
 nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Params& params) {
   using nlohmann::json;
   json out;
-  out["format"] = "leeway-bounds-1";
+  out["format"] = kBoundsFormat;
   out["units"] = "SI: metres, radians, milliseconds";
   out["cell"] = scene.source();
   out["joints"] = scene.joint_names();
@@ -140,13 +138,13 @@ nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Param
         if (below > 0 || above > 0)
           shrunk[scene.joints()[static_cast<size_t>(i)].name] = {{"lower_by", below}, {"upper_by", above}};
       }
-    wps.push_back({{"q", vec(w.q)},
-                   {"lower", vec(w.lower)},
-                   {"upper", vec(w.upper)},
+    wps.push_back({{"q", detail::to_json_array(w.q)},
+                   {"lower", detail::to_json_array(w.lower)},
+                   {"upper", detail::to_json_array(w.upper)},
                    {"collapsed", collapsed},
                    {"shrunk", shrunk},
-                   {"guide_lower", vec(w.guide_lower)},
-                   {"guide_upper", vec(w.guide_upper)},
+                   {"guide_lower", detail::to_json_array(w.guide_lower)},
+                   {"guide_upper", detail::to_json_array(w.guide_upper)},
                    {"nominal_in_volume", w.nominal_in_volume},
                    {"checks", w.checks}});
   }
@@ -172,18 +170,14 @@ nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Param
 }
 
 std::vector<WaypointBounds> read_bounds(const std::string& path, const Scene& scene) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open the bounds file");
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(path + ": malformed JSON: " + e.what());
-  }
+  const nlohmann::json j = detail::read_json_file(path, "bounds file");
   auto fail = [&](const std::string& what) { throw InputError(path + ": " + what); };
   try {
     if (!j.is_object() || !j.contains("joints") || !j.contains("waypoints"))
       fail("not a leeway bounds file (needs 'joints' and 'waypoints')");
+    // Older files have no 'format'; one that names another format is not ours to guess at.
+    if (j.contains("format") && j.at("format") != nlohmann::json(kBoundsFormat))
+      fail("format " + j.at("format").dump() + " is not a leeway bounds file (" + kBoundsFormat + ")");
     const auto names = j.at("joints").get<std::vector<std::string>>();
     if (names != scene.joint_names()) {
       std::string listed;
@@ -218,6 +212,14 @@ std::vector<WaypointBounds> read_bounds(const std::string& path, const Scene& sc
           fail(where + " joint '" + names[static_cast<size_t>(k)] + "': nominal " + format_number(w.q[k]) +
                " is not within [" + format_number(w.lower[k]) + ", " + format_number(w.upper[k]) + "]");
       w.collapsed.assign(static_cast<size_t>(scene.dof()), false);
+      if (wps[i].contains("collapsed")) {
+        // The names of the joints whose interval the collapse guard widened (bounds_json).
+        for (const auto& name : wps[i].at("collapsed").get<std::vector<std::string>>()) {
+          const auto it = std::find(names.begin(), names.end(), name);
+          if (it == names.end()) fail(where + " 'collapsed' names '" + name + "', not a joint of the robot");
+          w.collapsed[static_cast<size_t>(it - names.begin())] = true;
+        }
+      }
       out.push_back(std::move(w));
     }
     return out;

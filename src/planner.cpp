@@ -21,6 +21,7 @@
 #include <ompl/geometric/planners/rrt/RRTConnect.h>
 #include <ompl/util/Console.h>
 
+#include "json_io.hpp"
 #include "leeway/box.hpp"
 #include "leeway/error.hpp"
 
@@ -33,12 +34,6 @@ using nlohmann::json;
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-json vec(const Eigen::VectorXd& v) {
-  json a = json::array();
-  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v[i]);
-  return a;
 }
 
 // SplitMix64: independent, well-mixed 32-bit seeds for the planner's random streams from one
@@ -301,40 +296,61 @@ double weighted_length(const std::vector<Eigen::VectorXd>& path, const Eigen::Ve
 void validate(const PlanOptions& o) {
   auto finite_positive = [](double v, const std::string& what, double lo, double hi, const char* unit) {
     if (!(std::isfinite(v) && v >= lo && v <= hi))
-      throw InputError(what + " " + format_number(v) + " " + unit + " must be a finite number from " +
-                       format_number(lo) + " to " + format_number(hi));
+      throw InputError("plan option '" + what + "' = " + format_number(v) + " " + unit +
+                       " must be a finite number from " + format_number(lo) + " to " + format_number(hi));
   };
-  finite_positive(o.time_limit, "--time-limit", 1e-3, 86400, "s");
-  finite_positive(o.resolution, "--resolution", 1e-5, 1.0, "rad");
-  finite_positive(o.slide_resolution, "--slide-resolution", 1e-5, 1.0, "m");
+  finite_positive(o.time_limit, "time_limit", 1e-3, 86400, "s");
+  finite_positive(o.resolution, "resolution", 1e-5, 1.0, "rad");
+  finite_positive(o.slide_resolution, "slide_resolution", 1e-5, 1.0, "m");
   if (!(std::isfinite(o.range) && o.range >= 0))
-    throw InputError("--range " + format_number(o.range) +
+    throw InputError("plan option 'range' = " + format_number(o.range) +
                      " rad must be a finite number >= 0 (0: OMPL's default)");
   if (!(std::isfinite(o.clearance) && o.clearance >= 0 && o.clearance <= 10))
-    throw InputError("--clearance " + format_number(o.clearance) + " m must be a finite number from 0 to 10");
+    throw InputError("plan option 'clearance' = " + format_number(o.clearance) +
+                     " m must be a finite number from 0 to 10");
 }
 
-// OMPL logs to the console: keep its warnings and errors, drop its progress messages. Once per
-// process, so that a caller's own level set later wins.
-void quiet_ompl() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    if (ompl::msg::getLogLevel() < ompl::msg::LOG_WARN) ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
-  });
-}
+// OMPL logs to the console: keep its warnings and errors, drop its progress messages, but only
+// while a plan_path call runs. OMPL's level is process-wide, so overlapping calls (threads) share
+// one change: the first to enter lowers the noise, the last to leave restores the caller's level.
+class QuietOmpl {
+ public:
+  QuietOmpl() {
+    std::lock_guard<std::mutex> lock(mutex());
+    if (depth()++ == 0) {
+      saved() = ompl::msg::getLogLevel();
+      if (saved() < ompl::msg::LOG_WARN) ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+    }
+  }
+  ~QuietOmpl() {
+    std::lock_guard<std::mutex> lock(mutex());
+    if (--depth() == 0) ompl::msg::setLogLevel(saved());
+  }
+  QuietOmpl(const QuietOmpl&) = delete;
+  QuietOmpl& operator=(const QuietOmpl&) = delete;
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  static int& depth() {
+    static int d = 0;
+    return d;
+  }
+  static ompl::msg::LogLevel& saved() {
+    static ompl::msg::LogLevel level = ompl::msg::LOG_INFO;
+    return level;
+  }
+};
 
 json endpoint_json(const Endpoint& e) {
-  json out = {{"spec", e.spec}, {"q", vec(e.q)}};
+  json out = {{"spec", e.spec}, {"q", detail::to_json_array(e.q)}};
   out["keyframe"] = e.keyframe.empty() ? json(nullptr) : json(e.keyframe);
   out["site"] = e.site.empty() ? json(nullptr) : json(e.site);
   out["position"] =
       e.keyframe.empty() ? json({e.position.x(), e.position.y(), e.position.z()}) : json(nullptr);
   return out;
-}
-
-Eigen::VectorXd default_seed(const Scene& scene) {
-  if (!scene.keyframes().empty()) return scene.keyframes().front().q;
-  return Eigen::VectorXd::Zero(scene.dof()).cwiseMax(scene.lower_limits()).cwiseMin(scene.upper_limits());
 }
 
 }  // namespace
@@ -380,7 +396,7 @@ Eigen::Vector3d site_position(const Scene& scene, const std::string& name) {
   const int site = scene.goal_site(name);
   // Goal sites are outside the robot: any configuration gives their position.
   RobotState state(scene);
-  state.set(default_seed(scene));
+  state.set(default_ik_seed(scene));
   return state.site_pose(site).position;
 }
 
@@ -416,7 +432,7 @@ std::pair<Endpoint, Endpoint> resolve_endpoints(const Scene& scene, const std::s
     e.reachable = e.ik.success;
     e.q = e.ik.q;
   };
-  if (a.keyframe.empty()) solve(a, b.keyframe.empty() ? default_seed(scene) : b.q);
+  if (a.keyframe.empty()) solve(a, b.keyframe.empty() ? default_ik_seed(scene) : b.q);
   if (b.keyframe.empty()) solve(b, a.q);
   return {a, b};
 }
@@ -473,7 +489,7 @@ PlanResult plan_path(const Scene& scene, const Eigen::VectorXd& start, const Eig
     require_free(state, start, options.clearance, scene.source() + ": " + start_name);
     require_free(state, goal, options.clearance, scene.source() + ": " + goal_name);
   }
-  quiet_ompl();
+  const QuietOmpl quiet;  // restores OMPL's log level when plan_path returns or throws
   const auto t0 = std::chrono::steady_clock::now();
   const int n = scene.dof();
   auto checker = std::make_shared<Checker>(
@@ -481,7 +497,7 @@ PlanResult plan_path(const Scene& scene, const Eigen::VectorXd& start, const Eig
   PlanResult result;
 
   // The straight joint-space edge, when free, is the shortest path in the planner's metric: no
-  // sampling needed (the thesis's own nominal paths between keyframes are such edges).
+  // sampling needed (our reading: the thesis's own nominal paths between keyframes are such edges).
   if (options.try_direct && checker->edge_free(start, goal)) {
     result.success = true;
     result.method = "direct";
@@ -527,8 +543,8 @@ PlanResult plan_path(const Scene& scene, const Eigen::VectorXd& start, const Eig
     result.checks = checker->checks();
     result.message = "no collision-free path from " + start_name + " to " + goal_name +
                      " found within the time limit of " + format_number(options.time_limit) + " s (seed " +
-                     std::to_string(options.seed) + "); try a longer --time-limit or another --seed" +
-                     (options.clearance > 0 ? std::string(", or a smaller --clearance") : std::string());
+                     std::to_string(options.seed) + "); try a longer time limit or another seed" +
+                     (options.clearance > 0 ? std::string(", or a smaller clearance") : std::string());
     return result;
   }
 
@@ -574,7 +590,7 @@ json path_json(const Scene& scene, const PlanResult& result, const PlanOptions& 
   out["cell"] = scene.source();
   out["joints"] = scene.joint_names();
   json wps = json::array();
-  for (const auto& q : result.waypoints) wps.push_back({{"q", vec(q)}});
+  for (const auto& q : result.waypoints) wps.push_back({{"q", detail::to_json_array(q)}});
   out["waypoints"] = wps;
   out["from"] = endpoint_json(from);
   out["to"] = endpoint_json(to);
@@ -602,14 +618,7 @@ json path_json(const Scene& scene, const PlanResult& result, const PlanOptions& 
 }
 
 std::vector<Eigen::VectorXd> read_path(const std::string& path, const Scene& scene) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open the path file");
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::exception& e) {
-    throw InputError(path + ": malformed JSON: " + e.what());
-  }
+  const json j = detail::read_json_file(path, "path file");
   auto fail = [&](const std::string& what) { throw InputError(path + ": " + what); };
   try {
     if (!j.is_object() || !j.contains("joints") || !j.contains("waypoints"))

@@ -45,8 +45,6 @@ std::string format_number(double v) {
 Eigen::VectorXd parse_vector(const std::string& text, const std::string& what) {
   std::vector<double> values;
   std::string token;
-  std::istringstream in(text);
-  std::string chunk;
   std::vector<std::string> tokens;
   for (char c : text) {
     if (c == ',' || std::isspace(static_cast<unsigned char>(c))) {
@@ -172,7 +170,7 @@ void Scene::recognise(const SceneOptions& options) {
   tool_site_ = mj_name2id(&m, mjOBJ_SITE, options.tool_site.c_str());
   if (tool_site_ < 0)
     throw InputError(file + ": no site named '" + options.tool_site +
-                     "' (the robot's tool site; choose another with --tool)");
+                     "' for the robot's tool (SceneOptions::tool_site)");
   const int tool_body = m.site_bodyid[tool_site_];
   if (tool_body == 0 || top_ancestor(m, tool_body) != robot_root_ || m.body_weldid[tool_body] == 0)
     throw InputError(file + ": tool site '" + options.tool_site + "' is not on a moving body of the robot");

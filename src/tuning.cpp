@@ -51,7 +51,7 @@ CaseSpec parse_case(const std::string& text) {
   const auto first =
       second == std::string::npos || second == 0 ? std::string::npos : text.rfind(':', second - 1);
   if (first == std::string::npos || first == 0 || second == first + 1 || second + 1 == text.size())
-    throw InputError("--case '" + text +
+    throw InputError("tuning case '" + text +
                      "' must be CELL.xml:FROM:TO (a workcell file and two of its keyframes, e.g. "
                      "mjcf/workcells/dallara.xml:home:patch)");
   return {text.substr(0, first), text.substr(first + 1, second - first - 1), text.substr(second + 1)};
@@ -60,7 +60,7 @@ CaseSpec parse_case(const std::string& text) {
 TuningCase::TuningCase(const CaseSpec& spec, const nlohmann::json& base_json, int waypoints,
                        int pool_capacity, const SceneOptions& options)
     : spec_(spec) {
-  const std::string what = "--case '" + spec.cell + ":" + spec.from + ":" + spec.to + "'";
+  const std::string what = "tuning case '" + spec.cell + ":" + spec.from + ":" + spec.to + "'";
   try {
     if (!std::filesystem::is_regular_file(spec.cell)) throw InputError(spec.cell + ": no such file");
     scene_ = std::make_unique<Scene>(Scene::load(spec.cell, options));

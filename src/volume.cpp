@@ -308,8 +308,9 @@ void check_categories(const Categories& c) {
       throw InputError("volume generation: arm-base position #" + std::to_string(i) + " is not finite");
 }
 
-//! The activation's "box of the maximum possible height on a cell would touch a trail box" test
-//! (section 4.1), precomputed per trail box. The prisms of all cells differ only by a translation, so
+//! The activation's test of section 4.1 ("checking if any box in the trail would collide with a max
+//! height box instantiated in the cell"; leeway's max height is 3 h_max), precomputed per trail box.
+//! The prisms of all cells differ only by a translation, so
 //! each of the 15 separating axes of box_penetration(prism, trail box) and its radius sum ra + rb are
 //! fixed per trail box; per cell only the centre offset is projected. Same axes, same formula, same
 //! ">= 0 means touching" as box_penetration().
@@ -354,9 +355,9 @@ class PrismTrailTest {
 }  // namespace
 
 Grid make_grid(const HeightMapParams& p, const Categories& c, const VolumeParams& v) {
-  if (p.max_cells < 1 || p.max_cells > 1000000)
+  if (p.max_cells < 1 || p.max_cells > kMaxCellsLimit)
     throw InputError("parameter 'height_map.max_cells' = " + std::to_string(p.max_cells) +
-                     " must be between 1 and 1000000");
+                     " must be between 1 and " + std::to_string(kMaxCellsLimit));
   double x0 = p.origin_x, y0 = p.origin_y, x_dim = p.x_dim, y_dim = p.y_dim;
   if (p.auto_extent) {
     // Every floor point within reach_radius of an arm-base position: the bases' bounding rectangle

@@ -147,7 +147,7 @@ ModelPtr grow_last_body_geoms(const mjModel& m, int extra) {
 }
 
 VolumeModel::VolumeModel(const Scene& scene, int capacity) : scene_(&scene) {
-  install_mujoco_handlers();
+  install_mujoco_error_handlers();
   if (capacity < 1) throw InputError("volume pool capacity " + std::to_string(capacity) + " must be >= 1");
   const std::string& path = scene.source();
   std::ifstream in(path, std::ios::binary);

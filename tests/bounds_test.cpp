@@ -19,11 +19,62 @@ namespace {
 
 using test::one_link_cell;
 using test::workcell;
+using ::testing::HasSubstr;
 
 Eigen::VectorXd vec1(double v) {
   Eigen::VectorXd q(1);
   q << v;
   return q;
+}
+
+// ---------------------------------------------------------------------------------------------
+// WaypointBounds
+
+Eigen::VectorXd vec3(double a, double b, double c) { return Eigen::Vector3d(a, b, c); }
+
+TEST(WaypointBoundsTest, CheckedConstructorAndContains) {
+  const WaypointBounds w(vec3(0, 1, -1), vec3(-0.5, 0.5, -1), vec3(0.5, 1, 0));
+  EXPECT_EQ(w.collapsed, std::vector<bool>(3, false));
+  EXPECT_EQ(w.guide_lower, w.lower);
+  EXPECT_EQ(w.guide_upper, w.upper);
+  EXPECT_FALSE(w.nominal_in_volume);
+  EXPECT_EQ(w.checks, 0);
+  EXPECT_TRUE(w.contains(w.q));
+  EXPECT_TRUE(w.contains(w.lower));  // closed intervals
+  EXPECT_TRUE(w.contains(w.upper));
+  EXPECT_TRUE(w.contains(vec3(0.25, 0.75, -0.5)));
+  EXPECT_FALSE(w.contains(vec3(0.51, 0.75, -0.5)));
+  EXPECT_FALSE(w.contains(vec3(0, 0.49, -0.5)));
+  EXPECT_FALSE(w.contains(vec3(0, 0.75, NAN)));
+  EXPECT_THROW(w.contains(vec1(0.0)), InputError);
+
+  auto message = [](const Eigen::VectorXd& q, const Eigen::VectorXd& lo, const Eigen::VectorXd& hi) {
+    try {
+      WaypointBounds bad(q, lo, hi);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_THAT(message(vec3(0, 0, 0), vec1(0), vec3(0, 0, 0)), HasSubstr("lower 1"));
+  EXPECT_THAT(message(vec3(0, 0, 2), vec3(0, 0, 0), vec3(1, 1, 1)), HasSubstr("joint 2: nominal 2"));
+  EXPECT_THAT(message(vec3(0, 0, 0), vec3(0, 1, 0), vec3(1, 0, 1)), HasSubstr("joint 1"));
+  EXPECT_THAT(message(vec3(0, NAN, 0), vec3(0, 0, 0), vec3(1, 1, 1)), HasSubstr("not finite"));
+
+  // Default construction stays available for the algorithms that fill the fields.
+  WaypointBounds empty;
+  EXPECT_EQ(empty.q.size(), 0);
+}
+
+TEST(BoundUpperTest, LimitOnTheWrongSideIsRejected) {
+  const CollisionFn never = [](const Eigen::VectorXd&) { return false; };
+  long checks = 0;
+  EXPECT_THROW(bound_upper(never, vec1(0.5), 0, 0.2, 0.01, checks), InputError);
+  EXPECT_THROW(bound_lower(never, vec1(0.5), 0, 0.8, 0.01, checks), InputError);
+  EXPECT_THROW(bound_upper(never, vec1(0.5), 1, 1.0, 0.01, checks), InputError);
+  EXPECT_EQ(checks, 0);
+  // A limit at the value itself is allowed (a joint at its limit).
+  EXPECT_EQ(bound_upper(never, vec1(0.5), 0, 0.5, 0.01, checks), 0.5);
 }
 
 // ---------------------------------------------------------------------------------------------

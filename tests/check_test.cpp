@@ -59,6 +59,22 @@ TEST_F(CheckTest, JointLimitViolation) {
   EXPECT_TRUE(has_problem(r, "keyframe 'over': joint 'j1' = 3.1 rad is outside its range -3 .. 3 rad"));
 }
 
+TEST_F(CheckTest, CollidablePlaneIsAProblemNotAGoalObstacle) {
+  // The plane rule (box.hpp, has_bounding_box): check and categorize both leave planes out of
+  // Algorithm 1, so the goal above the table finds the table and the other goal finds nothing.
+  const auto r = run(R"(<geom name="ground" type="plane" size="5 5 0.1"/>
+    <geom name="table" type="box" size="0.2 0.2 0.2" pos="0 1 0.2"/>
+    <site name="goal" pos="0 1 0.5"/><site name="bare" pos="0 -1 0.5"/>)",
+                     R"(<key name="home" qpos="0"/>)");
+  EXPECT_TRUE(has_problem(r, "obstacle ground is a collidable plane"));
+  ASSERT_EQ(r.goals.size(), 2u);
+  EXPECT_EQ(scene_->geom_label(r.goals[0].goal_obstacle), "table");
+  EXPECT_EQ(r.goals[1].goal_obstacle, -1);
+  const int ground = scene_->obstacle_geoms().front();
+  EXPECT_FALSE(has_bounding_box(scene_->model(), ground));
+  EXPECT_TRUE(has_bounding_box(scene_->model(), scene_->obstacle_geoms().back()));
+}
+
 TEST_F(CheckTest, GoalWithNoObstacleBelow) {
   const auto r = run(R"(<geom name="table" type="box" size="0.2 0.2 0.2" pos="0 -1 0.2"/>
     <site name="goal" pos="0 1 0.5"/>)");

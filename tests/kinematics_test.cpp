@@ -132,6 +132,19 @@ TEST_F(KinematicsTest, DlrKeyframesAreOurIk) {
   }
 }
 
+TEST_F(KinematicsTest, DefaultIkSeedIsTheFirstKeyframeOrZeroWithinTheLimits) {
+  test::TempDir dir;
+  const Scene keyed = Scene::load(
+      dir.write("keyed.xml", one_link_cell("", R"(<key name="a" qpos="1.25"/><key name="b" qpos="2"/>)")));
+  EXPECT_EQ(default_ik_seed(keyed)[0], 1.25);
+  const Scene bare = Scene::load(dir.write("bare.xml", one_link_cell("")));
+  EXPECT_EQ(default_ik_seed(bare)[0], 0.0);
+  std::string xml = one_link_cell("");
+  xml.replace(xml.find("range=\"-3 3\""), 12, "range=\"0.5 3\"");
+  const Scene offset = Scene::load(dir.write("offset.xml", xml));
+  EXPECT_EQ(default_ik_seed(offset)[0], 0.5);  // zero clamped into the limits
+}
+
 TEST_F(KinematicsTest, IkOneLinkAnalyticAndUnreachable) {
   test::TempDir dir;
   const Scene scene = Scene::load(dir.write("cell.xml", one_link_cell("")));

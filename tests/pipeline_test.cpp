@@ -22,6 +22,7 @@ using nlohmann::json;
 using test::one_link_cell;
 using test::workcell;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 //! The message of the InputError that f throws, or "" (and a test failure) when it does not throw.
 std::string error_of(const std::function<void()>& f) {
@@ -72,6 +73,8 @@ TEST_F(PipelineTest, KeyframePathRejectsUnknownNamesAndTooFewWaypoints) {
   msg = error_of([&] { keyframe_path(scene, "home", "patch", 1); });
   EXPECT_THAT(msg, HasSubstr("1"));
   EXPECT_THAT(msg, HasSubstr(">= 2"));
+  EXPECT_THAT(msg, HasSubstr("waypoint count 1"));
+  EXPECT_THAT(msg, Not(HasSubstr("--")));  // the library names values, the programs their flags
   EXPECT_THROW(keyframe_path(scene, "home", "patch", 0), InputError);
   EXPECT_THROW(keyframe_path(scene, "home", "patch", -3), InputError);
 }
@@ -212,6 +215,45 @@ TEST_F(BoundsFileTest, ReadRejectsFilesThatDoNotFit) {
   text_value["waypoints"][0]["upper"][0] = "wide";
   const std::string tv_path = write("text.json", text_value);
   EXPECT_THAT(error_of([&] { read_bounds(tv_path, *scene_); }), HasSubstr(tv_path));
+}
+
+TEST_F(BoundsFileTest, ReadKeepsTheCollapsedJoints) {
+  json marked = file_;
+  marked["waypoints"][0]["collapsed"] = {"j2"};
+  marked["waypoints"][1]["collapsed"] = json::array({"j1", "j3"});
+  const auto back = read_bounds(write("collapsed.json", marked), *scene_);
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_EQ(back[0].collapsed, std::vector<bool>({false, true, false, false, false, false}));
+  EXPECT_EQ(back[1].collapsed, std::vector<bool>({true, false, true, false, false, false}));
+
+  // What bounds_json wrote comes back as it was.
+  const auto same = read_bounds(write("same.json", file_), *scene_);
+  for (size_t i = 0; i < same.size(); ++i) EXPECT_EQ(same[i].collapsed, run_.bounds[i].collapsed) << i;
+
+  json unknown = file_;
+  unknown["waypoints"][0]["collapsed"] = {"j9"};
+  const std::string path = write("unknown.json", unknown);
+  const std::string msg = error_of([&] { read_bounds(path, *scene_); });
+  EXPECT_THAT(msg, HasSubstr(path));
+  EXPECT_THAT(msg, HasSubstr("'j9'"));
+}
+
+TEST_F(BoundsFileTest, ReadChecksTheFormat) {
+  EXPECT_EQ(file_.at("format"), kBoundsFormat);
+  json other = file_;
+  other["format"] = "leeway-path-1";
+  const std::string path = write("path.json", other);
+  const std::string msg = error_of([&] { read_bounds(path, *scene_); });
+  EXPECT_THAT(msg, HasSubstr(path));
+  EXPECT_THAT(msg, HasSubstr("\"leeway-path-1\""));
+  EXPECT_THAT(msg, HasSubstr("leeway-bounds-1"));
+  json number = file_;
+  number["format"] = 1;
+  EXPECT_THAT(error_of([&] { read_bounds(write("number.json", number), *scene_); }), HasSubstr("format 1"));
+  // Files written before the format key existed are still read.
+  json old = file_;
+  old.erase("format");
+  EXPECT_EQ(read_bounds(write("old.json", old), *scene_).size(), 2u);
 }
 
 TEST(WriteFileAtomicTest, MissingFolderThrowsAndLeavesNothing) {

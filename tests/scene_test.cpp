@@ -121,7 +121,12 @@ TEST_F(SceneTest, UnlimitedJointIsRejected) {
 TEST_F(SceneTest, MissingToolSite) {
   std::string xml = one_link_cell("");
   xml.replace(xml.find("tool0"), 5, "flange");
-  expect_error(xml, {"no site named 'tool0'"});
+  expect_error(xml, {"no site named 'tool0'", "tool_site"});
+  try {
+    Scene::load(dir_.write("cell.xml", xml));
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).find("--"), std::string::npos) << "names a program flag: " << e.what();
+  }
 }
 
 TEST_F(SceneTest, KeyframeOfWrongLength) {

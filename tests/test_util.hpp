@@ -75,7 +75,7 @@ template <class Base = ::testing::Test>
 class MujocoTestOf : public Base {
  protected:
   void SetUp() override {
-    install_mujoco_handlers();
+    install_mujoco_error_handlers();
     take_mujoco_warnings();
   }
   void TearDown() override {

@@ -117,7 +117,7 @@ TEST(ParseCaseTest, MalformedCasesNameTheText) {
       parse_case(bad);
       ADD_FAILURE() << "no error for '" << bad << "'";
     } catch (const InputError& e) {
-      EXPECT_THAT(e.what(), HasSubstr(std::string("--case '") + bad + "' must be CELL.xml:FROM:TO"));
+      EXPECT_THAT(e.what(), HasSubstr(std::string("tuning case '") + bad + "' must be CELL.xml:FROM:TO"));
     }
   }
 }
@@ -515,7 +515,7 @@ TEST_F(TuningTest, BadCasesFailBeforeAnyEvaluation) {
   const std::string log = path("log.csv");
   const auto unknown = run_tune(quick("--case " + cell_ + ":a:nowhere --budget-evals 5 --log " + log));
   EXPECT_EQ(unknown.exit_code, kExitBadInput);
-  EXPECT_THAT(unknown.out, HasSubstr("leeway-tune: error: --case '" + cell_ + ":a:nowhere': "));
+  EXPECT_THAT(unknown.out, HasSubstr("leeway-tune: error: tuning case '" + cell_ + ":a:nowhere': "));
   EXPECT_THAT(unknown.out, HasSubstr("no keyframe 'nowhere'"));
   EXPECT_THAT(unknown.out, Not(HasSubstr("[1")));  // no evaluation, no calibration
   EXPECT_THAT(unknown.out, Not(HasSubstr("calibrating")));

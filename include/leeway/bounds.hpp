@@ -24,10 +24,15 @@ using CollisionFn = std::function<bool(const Eigen::VectorXd&)>;
 //! while the probe B is more than `delta` above the highest collision-free value A (the thesis's
 //! loop condition: the final bracket [A, C] can be up to 2 delta wide), and returns A (q[j] itself
 //! when every probe collides). `checks` is incremented per collision check.
+//! bound_upper and bound_lower share one implementation; they are two functions so that each call
+//! site reads as the thesis's Algorithm 2 or its mirror image (docs/algorithm.md names both), and
+//! so that each checks that `limit` lies on its side of q[j].
+//! @throws InputError when j is not an index of q or limit < q[j].
 double bound_upper(const CollisionFn& collides, Eigen::VectorXd q, int j, double limit, double delta,
                    long& checks);
 
-//! The symmetric lower-bound version of Algorithm 2.
+//! The symmetric lower-bound version of Algorithm 2 (see bound_upper).
+//! @throws InputError when j is not an index of q or limit > q[j].
 double bound_lower(const CollisionFn& collides, Eigen::VectorXd q, int j, double limit, double delta,
                    long& checks);
 
@@ -38,8 +43,18 @@ enum class BoundKind {
   kLinear,    //!< a fraction of the range around nominal (slide joints: the linear axis)
 };
 
-//! The bounds of one waypoint.
+//! The bounds of one waypoint. Default-constructed it is empty (the library's algorithms fill it);
+//! the three-vector constructor checks what it is given.
 struct WaypointBounds {
+  WaypointBounds() = default;
+  //! Bounds [lower, upper] around the nominal q, nothing collapsed, guide bounds equal to these.
+  //! @throws InputError when the sizes differ, a value is not finite or lower <= q <= upper fails.
+  WaypointBounds(Eigen::VectorXd q, Eigen::VectorXd lower, Eigen::VectorXd upper);
+
+  //! True when lower <= c <= upper in every joint.
+  //! @throws InputError when c's size differs from the bounds'.
+  bool contains(const Eigen::VectorXd& c) const;
+
   Eigen::VectorXd q;               //!< nominal configuration
   Eigen::VectorXd lower;           //!< lower bound per joint [rad or m]
   Eigen::VectorXd upper;           //!< upper bound per joint [rad or m]

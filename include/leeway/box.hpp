@@ -40,4 +40,12 @@ double box_distance(const Box& a, const Box& b, Eigen::Vector3d* on_a = nullptr,
 //! sphere (mesh, height field). Planes have no finite box: the returned half-size is infinite.
 Box geom_box(const mjModel& m, const mjData& d, int geom);
 
+//! The one rule for planes: false for a plane, true for every other geom type. A plane has no
+//! finite box, and an infinite box would contain every point above the floor (Algorithm 1 would
+//! make it every goal's obstacle) and meet every link (clearance 0). So planes take part in no
+//! box-based step: the goal search and categorisation (categorize, check_scene), the volume and
+//! the clearance all skip them; check_scene reports a collidable plane as a problem instead (a
+//! floor must have contype="0" conaffinity="0", docs/mjcf-conventions.md).
+bool has_bounding_box(const mjModel& m, int geom);
+
 }  // namespace leeway

@@ -24,7 +24,7 @@ struct CfResult {
   long collisions = 0;            //!< of which in collision
 };
 
-//! Section 4.1: the path (waypoints joined linearly in joint space, parameter s from 0 to
+//! Section 4.1, as leeway reads it: the path (waypoints joined linearly in joint space, parameter s from 0 to
 //! waypoints - 1) is split into `windows` equal windows; in each, `samples` configurations are drawn:
 //! s uniform in the window, then every joint uniform within the bounds linearly interpolated at s.
 //! Each is checked against the real obstacles (not the volume). Window w uses its own random

@@ -71,7 +71,7 @@ class RobotState {
 
 //! Options of the numerical inverse kinematics.
 struct IkOptions {
-  bool tool_down = true;                //!< also require the tool z-axis along world -z (every thesis pose)
+  bool tool_down = true;                //!< also require the tool z-axis along world -z (leeway's reading)
   std::vector<bool> locked;             //!< joints kept at the seed value (empty: none)
   int restarts = 24;                    //!< random restarts after the seed itself
   std::uint64_t seed = 1;               //!< RNG seed of the restarts
@@ -89,6 +89,11 @@ struct IkResult {
   double orientation_error = 0.0;  //!< |z_tool - (-e_z)| (0 when tool_down is off)
   int solutions_found = 0;         //!< distinct converged starts
 };
+
+//! The IK seed when the caller has none (check_scene's reach test, resolve_endpoints and
+//! site_position): the cell's first keyframe, which by convention is its home pose, or, in a cell
+//! without keyframes, the joint values nearest zero within the limits (the robot's zero pose).
+Eigen::VectorXd default_ik_seed(const Scene& scene);
 
 //! Damped-least-squares inverse kinematics for the tool site within the joint limits, restarted
 //! from the seed and from seeded random configurations; returns the converged solution nearest the

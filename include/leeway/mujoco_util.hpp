@@ -22,8 +22,13 @@ using ModelPtr = std::unique_ptr<mjModel, ModelDeleter>;
 using DataPtr = std::unique_ptr<mjData, DataDeleter>;
 
 //! Installs process-wide MuJoCo handlers: mju_error throws InputError (no abort), warnings are
-//! collected per thread instead of being written to MUJOCO_LOG.TXT. Idempotent and thread-safe.
-void install_mujoco_handlers();
+//! collected per thread (take_mujoco_warnings) instead of being written to MUJOCO_LOG.TXT.
+//! Idempotent and thread-safe. This changes global state (MuJoCo's mju_user_error and
+//! mju_user_warning), so programs call it once at the start of main(). The library also calls it,
+//! idempotently, before it compiles a model (load_model_file) or makes a RobotState or a
+//! VolumeModel, because MuJoCo's default handler would exit() the process on bad input; a program
+//! that installs its own handlers must do so after its first use of leeway.
+void install_mujoco_error_handlers();
 
 //! Returns and clears the MuJoCo warnings raised on this thread since the last call.
 std::vector<std::string> take_mujoco_warnings();

@@ -16,6 +16,11 @@ enum class DistanceMode {
   k3d,     //!< in 3D, from the cell centre on the floor (z = 0) to the box
 };
 
+//! The largest accepted height_map.max_cells: a million cells of 8-byte heights is 8 MB and a
+//! million candidate boxes, beyond any cell we have measured (docs/tuning.md tops out at 20000).
+//! Params::validate, make_grid and the programs' options all check against this one value.
+constexpr int kMaxCellsLimit = 1000000;
+
 //! The height-map of section 3.2.1.
 struct HeightMapParams {
   //! When true, the map is the rectangle covering every floor point within reach_radius of every
@@ -26,7 +31,7 @@ struct HeightMapParams {
   double origin_y = 0.0;  //!< [m]
   double x_dim = 0.0;     //!< map size along x [m]
   double y_dim = 0.0;     //!< map size along y [m]
-  int max_cells = 20000;  //!< MAX_cells: side = sqrt(x_dim * y_dim / MAX_cells)
+  int max_cells = 20000;  //!< MAX_cells: side = sqrt(x_dim * y_dim / MAX_cells); 1..kMaxCellsLimit
 };
 
 //! The height function, eq. 3.1 with the goal term of eq. 4.1, and the activation A_t.

@@ -1,7 +1,8 @@
 #pragma once
 //! @file path_check.hpp
 //! The dense check of a nominal path (issue #9, "the nominal path is checked first"): the thesis's
-//! method (chapter 3) bounds the joints around a nominal path that it assumes collision-free, so
+//! method (chapter 3) bounds the joints around a nominal path that, in our reading, it assumes
+//! collision-free, so
 //! every configuration along the path, not only the waypoints, is checked against the real
 //! obstacles before anything is bounded.
 

@@ -1,7 +1,9 @@
 #pragma once
 //! @file planner.hpp
 //! The global planner (issue #4): the nominal path between two gripper positions, as in the thesis
-//! (chapter 4: "the nominal path comes from RRT-Connect"). Endpoints are keyframes, goal sites or
+//! (chapter 3: "The development and testing of the algorithm were done using RRT-connect as a
+//! global planner"; section 4.1: the global planner takes "into input the starting and the goal
+//! position of the robot gripper"). Endpoints are keyframes, goal sites or
 //! points (inverse kinematics with the linear-axis policy first); OMPL's RRT-Connect plans in joint
 //! space over every robot joint against the real obstacles, OMPL's simplifier shortens the path,
 //! and leeway re-checks every edge. The path file format. docs/planning.md explains the guarantees.
@@ -110,7 +112,8 @@ struct PlanResult {
 //! every robot joint (within the MJCF limits), states checked against the real obstacles with one
 //! mjData per thread, edges checked at the motion resolution, then simplified. Every edge of the
 //! returned path passes edge_is_free() at the options' resolution and clearance. Thread-safe: plans
-//! may run concurrently on one Scene.
+//! may run concurrently on one Scene. While it runs, OMPL's process-wide log level is raised to
+//! LOG_WARN (progress messages dropped) when it is lower; the caller's level is restored on return.
 //! @throws InputError on invalid options, a start or goal of the wrong size, not finite, outside
 //! the limits, in collision or closer than the clearance margin (the message names the joint or
 //! the link and obstacle, with `start_name` / `goal_name`).

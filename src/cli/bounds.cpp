@@ -1,0 +1,224 @@
+#include "cli/bounds.hpp"
+
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+#include <utility>
+
+#include "leeway/path_check.hpp"
+#include "leeway/pipeline.hpp"
+
+namespace leeway::cli {
+namespace {
+
+using nlohmann::json;
+
+// "  (safety: lower +0.0312)": what the safety stage took off joint i's guide interval.
+std::string shrink_note(const WaypointBounds& w, int i) {
+  if (w.guide_lower.size() != w.lower.size() || w.guide_upper.size() != w.upper.size()) return "";
+  const double below = w.lower[i] - w.guide_lower[i], above = w.guide_upper[i] - w.upper[i];
+  if (!(below > 0) && !(above > 0)) return "";
+  std::ostringstream o;
+  o << std::fixed << std::setprecision(4) << "  (safety shrank it: lower +" << below << ", upper -" << above
+    << ")";
+  return o.str();
+}
+
+// One line on the safety stage: mode, outcome, work.
+void print_safety(const SafetyReport& r, const SafetyParams& params) {
+  int passed = 0;
+  for (const auto& s : r.segments) passed += s.passed ? 1 : 0;
+  const auto n = r.segments.size();
+  switch (r.mode) {
+    case SafetyMode::kNone:
+      std::cout << "safety: none (the thesis's bounds, not checked against the obstacles)\n";
+      break;
+    case SafetyMode::kCertified:
+      std::cout << "safety: certified, " << passed << " of " << n << " segments proven free (margin "
+                << format_number(params.margin) << " m; " << r.stats.leaves << " leaves, depth "
+                << r.stats.max_depth << ")"
+                << (r.all_passed ? "" : "; NOT CERTIFIED where the nominal path is too close") << "\n";
+      break;
+    case SafetyMode::kSampled:
+      std::cout << "safety: sampled, " << passed << " of " << n << " segments passed "
+                << r.samples_per_segment << " collision-free samples (epsilon "
+                << format_number(params.epsilon) << ", delta " << format_number(params.delta) << ")\n";
+      break;
+  }
+}
+
+}  // namespace
+
+CLI::App* add_bounds(CLI::App& app, BoundsArgs& args) {
+  CLI::App* sub = app.add_subcommand(
+      "bounds",
+      "Joint bounds along a path (thesis chapter 3): the joint-linear path between two keyframes, a\n"
+      "planned path when --from/--to name a gripper goal (site:NAME, xyz:X,Y,Z), or every waypoint of\n"
+      "a path file (--path). The path is checked densely first; a colliding straight path between two\n"
+      "keyframes is planned around (RRT-Connect). Exit 0 on success, 1 a colliding path, an unreachable\n"
+      "goal or no path, 2 bad input.");
+  sub->add_option("cell", args.cell, "MJCF file of the workcell")->required();
+  auto* path_opt =
+      sub->add_option("--path", args.path, "Path file written by leeway plan --out (instead of --from/--to)");
+  sub->add_option("--from", args.from, "Start: a keyframe, site:NAME or xyz:X,Y,Z")->excludes(path_opt);
+  sub->add_option("--to", args.to, "Goal: a keyframe, site:NAME or xyz:X,Y,Z")->excludes(path_opt);
+  sub->add_option("--waypoints", args.waypoints,
+                  "Waypoints along the joint-linear path between two keyframes (>= 2; the thesis: 2)")
+      ->capture_default_str();
+  sub->add_option("--seed", args.plan.seed, "Planner seed (gripper goals)")->capture_default_str();
+  sub->add_option("--time-limit", args.plan.time_limit, "Planner time budget [s] (gripper goals)")
+      ->capture_default_str();
+  sub->add_option("--ik-seed", args.ik_seed, "Keyframe seeding the inverse kinematics of gripper goals");
+  sub->add_option("--max-cells", args.max_cells,
+                  "MAX_cells of the height-map (default: from --params, 20000)");
+  sub->add_option("--params", args.params, "Parameter file (JSON; see leeway params)");
+  add_preset_options(sub, args.preset, args.safety);
+  sub->add_option("--out", args.out, "Write the bounds file here (JSON)");
+  sub->add_option("--threads", args.threads, "Worker threads")->capture_default_str();
+  sub->add_flag("--json", args.json, "Print the bounds file to standard output");
+  sub->add_flag("--no-plan", args.no_plan,
+                "Exit 1 when the straight path between two keyframes collides instead of planning around it");
+  sub->final_callback([sub, &args] {
+    args.max_cells_given = sub->count("--max-cells") > 0;
+    args.waypoints_given = sub->count("--waypoints") > 0;
+  });
+  return sub;
+}
+
+int run_bounds(const BoundsArgs& args) {
+  const auto scene = Scene::load(args.cell, scene_options(kDefaultTool));
+  Params p = load_params(scene, args.preset, args.params, args.safety);
+  if (args.max_cells_given) p.height_map.max_cells = args.max_cells;
+  p.validate();
+  if (args.threads < 1) throw InputError("--threads " + std::to_string(args.threads) + " must be >= 1");
+  std::vector<Eigen::VectorXd> path;
+  std::string label = args.from + " -> " + args.to;
+  const bool linear = args.path.empty() && !is_gripper_goal(args.from) && !is_gripper_goal(args.to);
+  if (!linear && args.waypoints_given)
+    throw InputError("--waypoints applies to the joint-linear path between two keyframes only, not to " +
+                     std::string(args.path.empty() ? "a planned path" : "--path"));
+  if (!args.path.empty()) {
+    path = read_path(args.path, scene);
+    label = args.path;
+  } else if (args.from.empty() || args.to.empty()) {
+    throw InputError(args.cell +
+                     ": give the path with --from and --to (keyframes, site:NAME or xyz:X,Y,Z)"
+                     " or with --path FILE");
+  } else if (linear) {
+    path = keyframe_path(scene, args.from, args.to, args.waypoints);
+  } else {
+    PlanResult planned;
+    Endpoint a, b;
+    if (!plan_between(scene, args.from, args.to, args.ik_seed, args.plan, planned, a, b))
+      return kExitFindings;
+    path = planned.waypoints;
+  }
+  // Issue #9: the nominal path is checked first, densely, whatever its source: the thesis's
+  // method (chapter 3) assumes it collision-free (our reading).
+  const PathCheckOptions check;
+  PathCheckResult checked = check_path(scene, path, check);
+  json nominal = {{"checked", true},
+                  {"resolution", check.resolution},
+                  {"slide_resolution", check.slide_resolution},
+                  {"planned", !linear && args.path.empty()}};
+  if (linear && !checked.free()) {
+    const PathCollision hit = *checked.collision;
+    const std::string what =
+        "the straight path from " + args.from + " to " + args.to +
+        (path.size() > 2 ? " (" + std::to_string(path.size()) + " waypoints)" : std::string()) + " " +
+        describe_collision(scene, hit, true);
+    // A keyframe that is not free itself cannot be planned around.
+    std::string stuck;
+    for (const auto& [key, q] : {std::pair{args.from, path.front()}, std::pair{args.to, path.back()}})
+      if (stuck.empty() && !check_path(scene, {q}, check).free()) stuck = key;
+    if (args.no_plan || !stuck.empty()) {
+      std::cerr << "leeway: collision: " << scene.source() << ": " << what
+                << (stuck.empty() ? ""
+                                  : "; keyframe '" + stuck + "' itself is not free, so no path avoids it")
+                << "; nothing written\n";
+      return kExitFindings;
+    }
+    PlanOptions around = args.plan;
+    around.try_direct = false;  // the straight edge may pass the planner's coarser check
+    const PlanResult planned = plan_path(scene, path.front(), path.back(), around,
+                                         "start '" + args.from + "'", "goal '" + args.to + "'");
+    if (!planned.success) {
+      std::cerr << "leeway: no path: " << scene.source() << ": " << what << "; " << planned.message
+                << "; nothing written\n";
+      return kExitFindings;
+    }
+    // Standard output stays one JSON object with --json.
+    (args.json ? std::cerr : std::cout)
+        << what << "; planned a path with " << planned.waypoints.size() << " waypoints (RRT-Connect, seed "
+        << around.seed << ")"
+        << (path.size() > 2 ? ", which replaces the " + std::to_string(path.size()) + " straight waypoints"
+                            : std::string())
+        << "\n";
+    nominal["planned"] = true;
+    nominal["replaced_straight_path"] = {
+        {"from", args.from},
+        {"to", args.to},
+        {"waypoints", path.size()},
+        {"obstacle", hit.obstacle_geom >= 0 ? json(hit.obstacle) : json(nullptr)},
+        {"link", hit.link_geom >= 0 ? json(hit.link) : json(nullptr)},
+        {"s", hit.path_fraction},
+        {"depth", hit.depth},
+        {"q", to_array(hit.q)},
+        {"checks", checked.checks},
+        {"planner",
+         {{"name", "RRTConnect"},
+          {"seed", around.seed},
+          {"time_limit", around.time_limit},
+          {"resolution", around.resolution},
+          {"slide_resolution", around.slide_resolution},
+          {"waypoints", planned.waypoints.size()}}}};
+    path = planned.waypoints;
+    label += " (planned around '" + hit.obstacle + "')";
+    checked = check_path(scene, path, check);
+  }
+  if (!checked.free()) {
+    // A path file, or a planned path that passed the planner's coarser edge check.
+    const bool planned = nominal["planned"].get<bool>();
+    std::cerr << "leeway: collision: " << (args.path.empty() ? scene.source() : args.path) << ": "
+              << (args.path.empty() ? "the path planned from " + args.from + " to " + args.to
+                                    : std::string("the path"))
+              << " " << describe_collision(scene, *checked.collision)
+              << (planned ? " when checked at " + format_number(check.resolution) +
+                                " rad (the planner checks at " + format_number(args.plan.resolution) + " rad)"
+                          : std::string())
+              << "; nothing written\n";
+    return kExitFindings;
+  }
+  nominal["checks"] = checked.checks;
+  VolumeModel world(scene, p.height_map.max_cells + static_cast<int>(scene.obstacle_geoms().size()));
+  const auto run = compute_bounds(scene, world, path, p, args.threads);
+  json out = bounds_json(scene, run, p);
+  out["nominal_path"] = nominal;
+  if (!args.out.empty()) write_file_atomic(args.out, out.dump(2) + "\n");
+  if (args.json) {
+    std::cout << out.dump(2) << "\n";
+    return kExitOk;
+  }
+  std::cout << scene.source() << " " << label << " (units: rad, m, ms)\n";
+  std::cout << "MAX_cells " << p.height_map.max_cells << ", boxes " << run.volume.boxes.size()
+            << ", goal obstacle " << out["goal_obstacle"].dump() << ", collision checks " << run.checks
+            << "\n";
+  std::cout << std::fixed << std::setprecision(4);
+  for (size_t w = 0; w < run.bounds.size(); ++w) {
+    std::cout << "waypoint " << w << ":\n";
+    for (int i = 0; i < scene.dof(); ++i)
+      std::cout << "  " << std::setw(8) << scene.joints()[static_cast<size_t>(i)].name << "  ["
+                << run.bounds[w].lower[i] << ", " << run.bounds[w].upper[i] << "]  nominal "
+                << run.bounds[w].q[i]
+                << (run.bounds[w].collapsed[static_cast<size_t>(i)] ? "  (collapsed, widened)" : "")
+                << shrink_note(run.bounds[w], i) << "\n";
+  }
+  print_safety(run.safety, p.safety);
+  std::cout << std::setprecision(1) << "time [ms]: categorize " << run.ms_categorize << ", volume "
+            << run.ms_volume << ", inject " << run.ms_inject << ", bounds " << run.ms_bounds << ", safety "
+            << run.ms_safety << ", total " << run.ms_total() << "\n";
+  if (!args.out.empty()) std::cout << "wrote " << args.out << "\n";
+  return kExitOk;
+}
+
+}  // namespace leeway::cli

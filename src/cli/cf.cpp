@@ -1,0 +1,49 @@
+#include "cli/cf.hpp"
+
+#include <iomanip>
+#include <iostream>
+
+#include "leeway/pipeline.hpp"
+
+namespace leeway::cli {
+
+CLI::App* add_cf(CLI::App& app, CfArgs& args) {
+  CLI::App* sub =
+      app.add_subcommand("cf", "Confidence Factor of a bounds file against the real obstacles (section 4.1)");
+  sub->add_option("cell", args.cell, "MJCF file of the workcell")->required();
+  sub->add_option("bounds", args.bounds, "Bounds file written by leeway bounds --out")->required();
+  sub->add_option("--windows", args.params.windows, "Windows along the path")->capture_default_str();
+  sub->add_option("--samples", args.params.samples, "Random configurations per window")
+      ->capture_default_str();
+  sub->add_option("--seed", args.params.seed, "Random seed")->capture_default_str();
+  sub->add_option("--threads", args.threads, "Worker threads")->capture_default_str();
+  sub->add_flag("--json", args.json, "Print JSON");
+  return sub;
+}
+
+int run_cf(const CfArgs& args) {
+  const auto scene = Scene::load(args.cell, scene_options(kDefaultTool));
+  if (args.threads < 1) throw InputError("--threads " + std::to_string(args.threads) + " must be >= 1");
+  const auto wb = read_bounds(args.bounds, scene);
+  const auto r = confidence_factor(scene, wb, args.params, args.threads);
+  if (args.json) {
+    nlohmann::json out = {{"cf", r.cf},
+                          {"ci95", {r.ci_low, r.ci_high}},
+                          {"worst_window", {{"index", r.worst_window}, {"cf", r.worst_window_cf}}},
+                          {"window_cf", r.window_cf},
+                          {"samples", r.samples},
+                          {"collisions", r.collisions},
+                          {"windows", args.params.windows},
+                          {"seed", args.params.seed},
+                          {"units", "cf and ci95 are fractions (1 = 100 %)"}};
+    std::cout << out.dump(2) << "\n";
+  } else {
+    std::cout << std::fixed << std::setprecision(4) << "CF " << 100 * r.cf << " % (95 % CI " << 100 * r.ci_low
+              << " .. " << 100 * r.ci_high << " %), " << r.collisions << " of " << r.samples
+              << " samples collide; worst window " << r.worst_window << " of " << args.params.windows << ": "
+              << 100 * r.worst_window_cf << " %\n";
+  }
+  return kExitOk;
+}
+
+}  // namespace leeway::cli

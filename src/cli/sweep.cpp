@@ -1,0 +1,117 @@
+#include "cli/sweep.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "leeway/path_check.hpp"
+#include "leeway/pipeline.hpp"
+#include "leeway/tuning.hpp"
+
+namespace leeway::cli {
+
+const char* const kThesisCells =
+    "100,150,200,500,750,1000,1500,2000,3000,5000,7500,10000,12000,15000,20000,25000,30000,40000,50000,"
+    "100000";
+
+std::vector<int> parse_cells_list(const std::string& text) {
+  std::vector<int> out;
+  const Eigen::VectorXd v = parse_vector(text, "--max-cells");
+  for (Eigen::Index i = 0; i < v.size(); ++i) {
+    if (v[i] != std::floor(v[i]) || v[i] < 1 || v[i] > kMaxCellsLimit)
+      throw InputError("--max-cells value '" +
+                       (std::abs(v[i]) < 1e15 && v[i] == std::floor(v[i])
+                            ? std::to_string(static_cast<long long>(v[i]))
+                            : format_number(v[i])) +
+                       "' must be a whole number from 1 to 1000000");
+    out.push_back(static_cast<int>(v[i]));
+  }
+  if (out.empty()) throw InputError("--max-cells lists no value");
+  return out;
+}
+
+CLI::App* add_sweep(CLI::App& app, SweepArgs& args) {
+  CLI::App* sub = app.add_subcommand(
+      "sweep", "The thesis's table: for each MAX_cells, boxes, time [ms] and CF [%], as Markdown (and CSV)");
+  sub->add_option("cell", args.cell, "MJCF file of the workcell")->required();
+  sub->add_option("--from", args.from, "Keyframe the path starts at")->required();
+  sub->add_option("--to", args.to, "Keyframe the path ends at")->required();
+  sub->add_option("--waypoints", args.waypoints, "Waypoints along the joint-linear path")
+      ->capture_default_str();
+  sub->add_option("--max-cells", args.max_cells,
+                  "Comma-separated MAX_cells values (default: the thesis's 20)");
+  sub->add_option("--params", args.params, "Parameter file (JSON)");
+  add_preset_options(sub, args.preset, args.safety);
+  sub->add_option("--csv", args.csv, "Also write the table as CSV here");
+  sub->add_option("--windows", args.cf.windows, "CF windows")->capture_default_str();
+  sub->add_option("--samples", args.cf.samples, "CF samples per window")->capture_default_str();
+  sub->add_option("--seed", args.cf.seed, "CF random seed")->capture_default_str();
+  sub->add_option("--threads", args.threads, "Worker threads")->capture_default_str();
+  sub->final_callback([sub, &args] {
+    args.windows_given = sub->count("--windows") > 0;
+    args.samples_given = sub->count("--samples") > 0;
+    args.seed_given = sub->count("--seed") > 0;
+  });
+  return sub;
+}
+
+int run_sweep(const SweepArgs& args) {
+  const auto scene = Scene::load(args.cell, scene_options(kDefaultTool));
+  const Params base = load_params(scene, args.preset, args.params, args.safety);
+  // CF settings: the parameter file's cf section unless given on the command line.
+  CfParams cf = args.cf;
+  if (!args.windows_given) cf.windows = base.cf.windows;
+  if (!args.samples_given) cf.samples = base.cf.samples;
+  if (!args.seed_given) cf.seed = base.cf.seed;
+  const std::vector<int> cells = parse_cells_list(args.max_cells);
+  if (args.threads < 1) throw InputError("--threads " + std::to_string(args.threads) + " must be >= 1");
+  const auto path = keyframe_path(scene, args.from, args.to, args.waypoints);
+  // Issue #9: the nominal path is checked first; a sweep bounds the straight path only.
+  if (const auto checked = check_path(scene, path); !checked.free()) {
+    std::cerr << "leeway: collision: " << scene.source() << ": the straight path from " << args.from << " to "
+              << args.to
+              << (path.size() > 2 ? " (" + std::to_string(path.size()) + " waypoints)" : std::string()) << " "
+              << describe_collision(scene, *checked.collision, true) << "; nothing written\n";
+    return kExitFindings;
+  }
+  for (int c : cells) {
+    Params p = base;
+    p.height_map.max_cells = c;
+    p.validate();
+  }
+  VolumeModel world(
+      scene, *std::max_element(cells.begin(), cells.end()) + static_cast<int>(scene.obstacle_geoms().size()));
+  std::ostringstream md, csv;
+  md << "| Max CBox | CBox | Computational Time [ms] | Confidence Factor [%] | 95 % CI [%] |"
+        " worst window [%] | collapsed | mean width j1-j3 [rad] |\n"
+     << "|---:|---:|---:|---:|---|---:|---:|---:|\n";
+  csv << "max_cells,boxes,time_ms,volume_ms,bounds_ms,checks,cf,ci_low,ci_high,worst_window_cf,collapsed,"
+         "mean_width\n";
+  for (int c : cells) {
+    Params p = base;
+    p.height_map.max_cells = c;
+    const auto run = compute_bounds(scene, world, path, p, args.threads);
+    const auto r = confidence_factor(scene, run.bounds, cf, args.threads);
+    // Collapsed intervals and the mean width of the bisected joints' intervals.
+    CaseEval stats;
+    width_stats(scene, run.bounds, 0.0, stats);
+    const int collapsed = stats.collapsed, bisected = stats.bisected;
+    const double width = stats.mean_width;
+    md << std::fixed << "| " << c << " | " << run.volume.boxes.size() << " | " << std::setprecision(1)
+       << run.ms_total() << " | " << std::setprecision(4) << 100 * r.cf << " | " << 100 * r.ci_low << " .. "
+       << 100 * r.ci_high << " | " << 100 * r.worst_window_cf << " | " << collapsed << "/" << bisected
+       << " | " << std::setprecision(3) << width << " |\n";
+    csv << c << "," << run.volume.boxes.size() << "," << std::setprecision(3) << run.ms_total() << ","
+        << run.ms_volume << "," << run.ms_bounds << "," << run.checks << "," << std::setprecision(6) << r.cf
+        << "," << r.ci_low << "," << r.ci_high << "," << r.worst_window_cf << "," << collapsed << "," << width
+        << "\n";
+    std::cerr << "max_cells " << c << " done\n";
+  }
+  std::cout << md.str();
+  if (!args.csv.empty()) write_file_atomic(args.csv, csv.str());
+  return kExitOk;
+}
+
+}  // namespace leeway::cli

@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
   CLI::App app{
       "leeway: collision-free joint intervals around a nominal robot path (SI units: metres, radians)"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "leeway 0.1.0");
+  app.set_version_flag("--version", std::string("leeway ") + LEEWAY_VERSION);
 
   CheckArgs check;
   FkArgs fk;

@@ -172,7 +172,7 @@ TEST_F(CliBoundsTest, BadInputsExitTwoNameTheValueAndWriteNothing) {
       {bounds + "--params " + lb, {"lb.json", "d_t_lb", "= 2", "d_t_ub"}},
       {bounds + "--params " + malformed, {"malformed.json", "malformed JSON"}},
       {bounds + "--params " + nan, {"nan.json", "d_t_lb", "\"nan\""}},
-      {bounds + "--waypoints 1", {"waypoint count 1", "must be >= 2"}},
+      {bounds + "--waypoints 1", {"--waypoints 1", "must be >= 2"}},
       {bounds + "--threads 0", {"--threads 0"}},
       {sweep + "--max-cells 0", {"--max-cells", "'0'"}},
       {sweep + "--max-cells 100,-3", {"--max-cells", "'-3'"}},

@@ -105,6 +105,9 @@ int run_bounds(const BoundsArgs& args) {
                      ": give the path with --from and --to (keyframes, site:NAME or xyz:X,Y,Z)"
                      " or with --path FILE");
   } else if (linear) {
+    // The library names the data; the command line names its flag.
+    if (args.waypoints < 2)
+      throw InputError("--waypoints " + std::to_string(args.waypoints) + " must be >= 2");
     path = keyframe_path(scene, args.from, args.to, args.waypoints);
   } else {
     PlanResult planned;

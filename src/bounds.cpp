@@ -92,6 +92,15 @@ double bound_lower(const CollisionFn& collides, Eigen::VectorXd q, int j, double
   return bisect_towards(collides, std::move(q), j, limit, delta, checks);
 }
 
+void require_joint_counts(const Scene& scene, const std::vector<WaypointBounds>& bounds) {
+  for (size_t k = 0; k < bounds.size(); ++k) {
+    const auto& w = bounds[k];
+    if (w.q.size() != scene.dof() || w.lower.size() != scene.dof() || w.upper.size() != scene.dof())
+      throw InputError("bounds of waypoint " + std::to_string(k) + " have the wrong number of joints for " +
+                       scene.source());
+  }
+}
+
 std::vector<BoundKind> bound_kinds(const Scene& scene) {
   std::vector<BoundKind> kinds;
   int hinges = 0;

@@ -22,6 +22,18 @@ struct Cell {
 
 Eigen::Vector3d vec3(const double* p) { return Eigen::Vector3d(p[0], p[1], p[2]); }
 
+// True when `box` grown by `grow` [m] on every side touches or overlaps the obstacle: a box by the
+// separating-axis test, a plane as the half-space below its surface (normal = its z axis).
+bool touches(const Box& box, double grow, const Box& obstacle, bool plane) {
+  Box grown = box;
+  grown.half_size.array() += grow;
+  if (!plane) return box_penetration(grown, obstacle) >= 0;
+  const Eigen::Vector3d nrm = obstacle.rotation.col(2);
+  return nrm.dot(box.center - obstacle.center) -
+             (box.rotation.transpose() * nrm).cwiseAbs().dot(grown.half_size) <=
+         0;
+}
+
 void check_box(const Scene& scene, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper) {
   if (lower.size() != scene.dof() || upper.size() != scene.dof())
     throw InputError("certify: a region needs " + std::to_string(scene.dof()) + " joint values per bound");
@@ -105,13 +117,14 @@ Certifier::Certifier(const Scene& scene, CertifyOptions options)
     o.radius = o.plane ? INFINITY : o.box.half_size.norm();
     obstacles_.push_back(o);
   }
+  all_pairs_.resize(links_.size() * obstacles_.size());
+  for (size_t i = 0; i < all_pairs_.size(); ++i) all_pairs_[i] = static_cast<int>(i);
 }
 
 bool Certifier::leaf_free(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, CertifyStats& stats,
                           CertifyFailure* failure) {
   check_box(*scene_, lower, upper);
-  std::vector<int> pairs(links_.size() * obstacles_.size());
-  for (size_t i = 0; i < pairs.size(); ++i) pairs[i] = static_cast<int>(i);
+  std::vector<int> pairs = all_pairs_;
   return leaf_free_impl(lower, upper, pairs, stats, failure);
 }
 
@@ -331,15 +344,7 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
     };
     if (options_.bound == CertifyBound::kLever) {
       // The link's box at c grown by lever_radius on every side, against the obstacle.
-      Box grown = box;
-      grown.half_size.array() += lever_radius + margin;
-      if (obs.plane) {
-        const Eigen::Vector3d nrm = obs.box.rotation.col(2);
-        const double r = (box.rotation.transpose() * nrm).cwiseAbs().dot(grown.half_size);
-        separated = nrm.dot(box.center - obs.box.center) - r > 0;
-      } else {
-        separated = box_penetration(grown, obs.box) < 0;
-      }
+      separated = !touches(box, lever_radius + margin, obs.box, obs.plane);
     } else {
       const Eigen::Vector3d diff = obs.box.center - box.center;
       if (!obs.plane && diff.norm() - iso - obs.radius > margin) {
@@ -393,17 +398,8 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
       failure->split_joint = best;
       failure->budget = false;
     }
-    if (failure && !failure->centre_hits) {
-      // Does the centre configuration itself come within the margin? Then no split can help.
-      Box grown = box;
-      grown.half_size.array() += margin;
-      const Eigen::Vector3d nrm = obs.box.rotation.col(2);
-      failure->centre_hits = obs.plane
-                                 ? nrm.dot(box.center - obs.box.center) -
-                                           (box.rotation.transpose() * nrm).cwiseAbs().dot(grown.half_size) <=
-                                       0
-                                 : box_penetration(grown, obs.box) >= 0;
-    }
+    // Does the centre configuration itself come within the margin? Then no split can help.
+    if (failure && !failure->centre_hits) failure->centre_hits = touches(box, margin, obs.box, obs.plane);
     failing.push_back(pair);
   }
   pairs = std::move(failing);
@@ -437,8 +433,7 @@ bool Certifier::region_free_impl(const Eigen::VectorXd& lower, const Eigen::Vect
     return true;
   };
   Cell root{lower, upper, 0, {}};
-  root.pairs.resize(links_.size() * obstacles_.size());
-  for (size_t i = 0; i < root.pairs.size(); ++i) root.pairs[i] = static_cast<int>(i);
+  root.pairs = all_pairs_;
   if (!test(std::move(root))) return false;
   while (!heap.empty()) {
     std::pop_heap(heap.begin(), heap.end(), worse);
@@ -479,8 +474,7 @@ bool Certifier::probe(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper
       for (size_t m = 0; m < moving.size(); ++m)
         p[moving[m]] = (bits >> m) & 1 ? upper[moving[m]] : lower[moving[m]];
     }
-    std::vector<int> pairs(links_.size() * obstacles_.size());
-    for (size_t i = 0; i < pairs.size(); ++i) pairs[i] = static_cast<int>(i);
+    std::vector<int> pairs = all_pairs_;
     const Eigen::VectorXd offsets = (p - nominal).cwiseAbs();
     if (leaf_free_impl(p, p, pairs, stats, &local, &offsets)) continue;
     local.centre_hits = true;

@@ -37,11 +37,9 @@ CfResult confidence_factor(const Scene& scene, const std::vector<WaypointBounds>
   if (params.windows < 1) throw InputError("CF windows " + std::to_string(params.windows) + " must be >= 1");
   if (params.samples < 1) throw InputError("CF samples " + std::to_string(params.samples) + " must be >= 1");
   if (bounds.empty()) throw InputError("CF needs at least one bounded waypoint");
+  require_joint_counts(scene, bounds);
   for (size_t i = 0; i < bounds.size(); ++i) {
     const auto& b = bounds[i];
-    if (b.q.size() != scene.dof() || b.lower.size() != scene.dof() || b.upper.size() != scene.dof())
-      throw InputError("bounds of waypoint " + std::to_string(i) + " have the wrong number of joints for " +
-                       scene.source());
     if (!b.lower.allFinite() || !b.upper.allFinite() || (b.lower.array() > b.upper.array()).any())
       throw InputError("bounds of waypoint " + std::to_string(i) + " are not finite or have lower > upper");
   }
@@ -61,11 +59,7 @@ CfResult confidence_factor(const Scene& scene, const std::vector<WaypointBounds>
         const double t = bounds.size() == 1 ? 0.0 : s - seg;
         const WaypointBounds& a = bounds[static_cast<size_t>(seg)];
         const WaypointBounds& b = bounds[std::min(bounds.size() - 1, static_cast<size_t>(seg) + 1)];
-        for (int i = 0; i < scene.dof(); ++i) {
-          const double lo = a.lower[i] + t * (b.lower[i] - a.lower[i]);
-          const double hi = a.upper[i] + t * (b.upper[i] - a.upper[i]);
-          q[i] = lo + (hi - lo) * unit(rng);
-        }
+        detail::draw_in_segment(a.lower, a.upper, b.lower, b.upper, t, rng, q);
         ok += state->in_collision(q) ? 0 : 1;
       }
       free_count[static_cast<size_t>(w)] = ok;

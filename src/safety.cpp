@@ -200,6 +200,7 @@ SegmentSafety sample_segment(RobotState& state, Extents& e, size_t a, size_t b, 
                              std::uint64_t seed, size_t segment) {
   SegmentSafety s;
   const int n = static_cast<int>(e.q[a].size());
+  bool nominal = false;  // every extent of both ends is zero
   for (int round = 0; round < 200; ++round) {
     ++s.rounds;
     std::mt19937_64 rng(splitmix(seed ^ splitmix(segment * 1000003ULL + static_cast<std::uint64_t>(round))));
@@ -208,10 +209,7 @@ SegmentSafety sample_segment(RobotState& state, Extents& e, size_t a, size_t b, 
     Eigen::VectorXd q(n);
     for (long k = 0; k < n_samples && !hit; ++k) {
       const double t = a == b ? 0.0 : unit(rng);
-      for (int i = 0; i < n; ++i) {
-        const double lo = la[i] + t * (lb[i] - la[i]), hi = ua[i] + t * (ub[i] - ua[i]);
-        q[i] = lo + (hi - lo) * unit(rng);
-      }
+      detail::draw_in_segment(la, ua, lb, ub, t, rng, q);
       ++s.samples;
       hit = state.in_collision(q);
     }
@@ -219,18 +217,16 @@ SegmentSafety sample_segment(RobotState& state, Extents& e, size_t a, size_t b, 
       s.passed = true;
       return s;
     }
-    bool shrunk = false;
+    // Already down to the nominal segment and still hit: nothing is left to shrink.
+    if (nominal) return s;
+    nominal = true;
     for (size_t k : {a, b})
       for (int i = 0; i < n; ++i)
         for (double* extent : {&e.below[k][i], &e.above[k][i]}) {
           *extent = *extent * 0.8 < kTinyExtent ? 0.0 : *extent * 0.8;
-          shrunk = shrunk || *extent > 0;
+          nominal = nominal && *extent == 0;
         }
     ++s.shrink_steps;
-    if (!shrunk) {
-      // Down to the nominal segment: one more round says whether it passes.
-      continue;
-    }
   }
   return s;
 }
@@ -247,11 +243,9 @@ SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, 
   report.mode = params.mode;
   if (params.mode == SafetyMode::kNone || bounds.empty()) return report;
   const auto t0 = std::chrono::steady_clock::now();
+  require_joint_counts(scene, bounds);
   for (size_t k = 0; k < bounds.size(); ++k) {
     const auto& w = bounds[k];
-    if (w.q.size() != scene.dof() || w.lower.size() != scene.dof() || w.upper.size() != scene.dof())
-      throw InputError("bounds of waypoint " + std::to_string(k) + " have the wrong number of joints for " +
-                       scene.source());
     if (!(w.lower.array() <= w.q.array()).all() || !(w.q.array() <= w.upper.array()).all())
       throw InputError("bounds of waypoint " + std::to_string(k) + " do not contain the nominal value");
   }

@@ -71,6 +71,10 @@ struct WaypointBounds {
 WaypointBounds bound_waypoint(const Scene& scene, const CollisionFn& collides, const Eigen::VectorXd& q,
                               const BoundsParams& params);
 
+//! Checks that every waypoint's q, lower and upper have one value per joint of `scene`.
+//! @throws InputError naming the waypoint and the scene otherwise.
+void require_joint_counts(const Scene& scene, const std::vector<WaypointBounds>& bounds);
+
 //! The kind of every joint, in order.
 std::vector<BoundKind> bound_kinds(const Scene& scene);
 

@@ -130,6 +130,7 @@ class Certifier {
   std::vector<Link> links_;
   std::vector<Obstacle> obstacles_;
   std::vector<bool> prismatic_;
+  std::vector<int> all_pairs_;  //!< every (link, obstacle) pair index, link-major
 };
 
 }  // namespace leeway

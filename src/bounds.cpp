@@ -73,6 +73,11 @@ WaypointBounds::WaypointBounds(Eigen::VectorXd q_in, Eigen::VectorXd lower_in, E
   guide_upper = upper;
 }
 
+std::pair<double, double> WaypointBounds::shrunk_by(Eigen::Index i) const {
+  if (guide_lower.size() != lower.size() || guide_upper.size() != upper.size()) return {0.0, 0.0};
+  return {lower[i] - guide_lower[i], guide_upper[i] - upper[i]};
+}
+
 bool WaypointBounds::contains(const Eigen::VectorXd& c) const {
   if (c.size() != lower.size() || c.size() != upper.size())
     throw InputError("configuration of " + std::to_string(c.size()) + " values against waypoint bounds of " +

@@ -132,12 +132,11 @@ nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Param
       if (w.collapsed[i]) collapsed.push_back(scene.joints()[i].name);
     // Per joint: how much the safety stage took off the guide interval [rad or m].
     json shrunk = json::object();
-    if (w.guide_lower.size() == w.lower.size() && w.guide_upper.size() == w.upper.size())
-      for (Eigen::Index i = 0; i < w.lower.size(); ++i) {
-        const double below = w.lower[i] - w.guide_lower[i], above = w.guide_upper[i] - w.upper[i];
-        if (below > 0 || above > 0)
-          shrunk[scene.joints()[static_cast<size_t>(i)].name] = {{"lower_by", below}, {"upper_by", above}};
-      }
+    for (Eigen::Index i = 0; i < w.lower.size(); ++i) {
+      const auto [below, above] = w.shrunk_by(i);
+      if (below > 0 || above > 0)
+        shrunk[scene.joints()[static_cast<size_t>(i)].name] = {{"lower_by", below}, {"upper_by", above}};
+    }
     wps.push_back({{"q", detail::to_json_array(w.q)},
                    {"lower", detail::to_json_array(w.lower)},
                    {"upper", detail::to_json_array(w.upper)},

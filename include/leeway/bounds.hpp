@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "leeway/params.hpp"
@@ -54,6 +55,10 @@ struct WaypointBounds {
   //! True when lower <= c <= upper in every joint.
   //! @throws InputError when c's size differs from the bounds'.
   bool contains(const Eigen::VectorXd& c) const;
+
+  //! What the safety stage took off joint i's guide interval [rad or m]: {from below, from above};
+  //! {0, 0} when no guide is recorded (bounds read from a file).
+  std::pair<double, double> shrunk_by(Eigen::Index i) const;
 
   Eigen::VectorXd q;               //!< nominal configuration
   Eigen::VectorXd lower;           //!< lower bound per joint [rad or m]

@@ -15,8 +15,7 @@ using nlohmann::json;
 
 // "  (safety: lower +0.0312)": what the safety stage took off joint i's guide interval.
 std::string shrink_note(const WaypointBounds& w, int i) {
-  if (w.guide_lower.size() != w.lower.size() || w.guide_upper.size() != w.upper.size()) return "";
-  const double below = w.lower[i] - w.guide_lower[i], above = w.guide_upper[i] - w.upper[i];
+  const auto [below, above] = w.shrunk_by(i);
   if (!(below > 0) && !(above > 0)) return "";
   std::ostringstream o;
   o << std::fixed << std::setprecision(4) << "  (safety shrank it: lower +" << below << ", upper -" << above

@@ -21,14 +21,18 @@
 #include <string>
 #include <vector>
 
+#include "leeway/cell_defaults.hpp"
 #include "leeway/certify.hpp"
 #include "leeway/error.hpp"
+#include "leeway/file_io.hpp"
+#include "leeway/nominal_path.hpp"
 #include "leeway/pipeline.hpp"
 #include "leeway/tuning.hpp"
+#include "statistics.hpp"
 
 namespace {
 
-using leeway::median;
+using leeway::detail::median;
 using nlohmann::json;
 
 double now_ms() {

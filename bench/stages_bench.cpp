@@ -13,13 +13,17 @@
 #include <string>
 #include <vector>
 
+#include "leeway/cell_defaults.hpp"
 #include "leeway/error.hpp"
+#include "leeway/nominal_path.hpp"
 #include "leeway/pipeline.hpp"
 #include "leeway/tuning.hpp"
+#include "random.hpp"
+#include "statistics.hpp"
 
 namespace {
 
-using leeway::median;
+using leeway::detail::median;
 
 double now_ms() {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch())
@@ -99,9 +103,9 @@ int main(int argc, char** argv) {
       std::mt19937_64 rng(1);
       std::vector<Eigen::VectorXd> qs;
       for (int k = 0; k < 400; ++k) {
-        const double s = static_cast<double>(rng() >> 11) * 0x1.0p-53;
+        const double s = leeway::detail::unit(rng);
         Eigen::VectorXd q = path[0] + s * (path[1] - path[0]);
-        for (int i = 0; i < q.size(); ++i) q[i] += 0.2 * (static_cast<double>(rng() >> 11) * 0x1.0p-53 - 0.5);
+        for (int i = 0; i < q.size(); ++i) q[i] += 0.2 * (leeway::detail::unit(rng) - 0.5);
         qs.push_back(q.cwiseMax(scene.lower_limits()).cwiseMin(scene.upper_limits()));
       }
       std::vector<double> kin, full;

@@ -24,6 +24,7 @@
 #include "json_io.hpp"
 #include "leeway/box.hpp"
 #include "leeway/error.hpp"
+#include "random.hpp"
 
 namespace leeway {
 namespace {
@@ -36,14 +37,10 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// SplitMix64: independent, well-mixed 32-bit seeds for the planner's random streams from one
-// user seed (OMPL's RNG takes 32 bits; 0 is avoided, OMPL rejects it as a global seed).
+// Independent, well-mixed 32-bit seeds for the planner's random streams from one user seed (OMPL's
+// RNG takes 32 bits; 0 is avoided, OMPL rejects it as a global seed).
 std::uint32_t stream_seed(std::uint64_t seed, std::uint64_t stream) {
-  std::uint64_t z = seed + 0x9e3779b97f4a7c15ULL * (stream + 1);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  z ^= z >> 31;
-  const auto s = static_cast<std::uint32_t>(z >> 32);
+  const auto s = static_cast<std::uint32_t>(detail::splitmix(seed + 0x9e3779b97f4a7c15ULL * stream) >> 32);
   return s == 0 ? 1u : s;
 }
 
@@ -344,98 +341,7 @@ class QuietOmpl {
   }
 };
 
-json endpoint_json(const Endpoint& e) {
-  json out = {{"spec", e.spec}, {"q", detail::to_json_array(e.q)}};
-  out["keyframe"] = e.keyframe.empty() ? json(nullptr) : json(e.keyframe);
-  out["site"] = e.site.empty() ? json(nullptr) : json(e.site);
-  out["position"] =
-      e.keyframe.empty() ? json({e.position.x(), e.position.y(), e.position.z()}) : json(nullptr);
-  return out;
-}
-
 }  // namespace
-
-Eigen::VectorXd place_slides(const Scene& scene, const Eigen::Vector3d& goal, const Eigen::VectorXd& q) {
-  scene.validate_configuration(q, "linear-axis policy configuration");
-  if (!goal.allFinite()) throw InputError("linear-axis policy: the goal position is not finite");
-  int base_joint = -1;
-  for (const auto& j : scene.joints())
-    if (!j.prismatic) {
-      base_joint = j.id;
-      break;
-    }
-  RobotState state(scene);
-  Eigen::VectorXd out = q;
-  for (int i = 0; i < scene.dof(); ++i) {
-    const RobotJoint& joint = scene.joints()[static_cast<size_t>(i)];
-    if (!joint.prismatic) continue;
-    out[i] = 0.0;
-    state.set(out);
-    const mjData& d = state.data();
-    const Eigen::Vector3d base =
-        base_joint >= 0 ? Eigen::Vector3d(Eigen::Map<const Eigen::Vector3d>(d.xanchor + 3 * base_joint))
-                        : state.tool_pose().position;
-    const Eigen::Vector3d axis = Eigen::Map<const Eigen::Vector3d>(d.xaxis + 3 * joint.id).normalized();
-    out[i] = std::clamp(axis.dot(goal - base), joint.lower, joint.upper);
-  }
-  return out;
-}
-
-IkResult gripper_ik(RobotState& state, const Eigen::Vector3d& goal, const Eigen::VectorXd& seed,
-                    IkOptions options) {
-  const Scene& scene = state.scene();
-  scene.validate_configuration(seed, "IK seed");
-  if (!goal.allFinite()) throw InputError("IK target position is not finite");
-  options.locked.resize(static_cast<size_t>(scene.dof()), false);
-  for (int i = 0; i < scene.dof(); ++i)
-    if (scene.joints()[static_cast<size_t>(i)].prismatic) options.locked[static_cast<size_t>(i)] = true;
-  return solve_ik(state, goal, place_slides(scene, goal, seed), options);
-}
-
-Eigen::Vector3d site_position(const Scene& scene, const std::string& name) {
-  const int site = scene.goal_site(name);
-  // Goal sites are outside the robot: any configuration gives their position.
-  RobotState state(scene);
-  state.set(default_ik_seed(scene));
-  return state.site_pose(site).position;
-}
-
-std::pair<Endpoint, Endpoint> resolve_endpoints(const Scene& scene, const std::string& from,
-                                                const std::string& to, const EndpointOptions& options) {
-  auto parse = [&](const std::string& spec) {
-    Endpoint e;
-    e.spec = spec;
-    if (spec.rfind("site:", 0) == 0) {
-      e.site = spec.substr(5);
-      if (e.site.empty()) throw InputError(scene.source() + ": '" + spec + "' names no site (site:NAME)");
-      e.position = site_position(scene, e.site);
-    } else if (spec.rfind("xyz:", 0) == 0) {
-      const Eigen::VectorXd v = parse_vector(spec.substr(4), "'" + spec + "'");
-      if (v.size() != 3)
-        throw InputError("'" + spec + "' must give three coordinates x,y,z [m], got " +
-                         std::to_string(v.size()));
-      e.position = v;
-    } else {
-      if (spec.empty())
-        throw InputError(scene.source() + ": an empty path end (give a keyframe or site:NAME)");
-      e.keyframe = spec;
-      e.q = scene.keyframe(spec).q;
-    }
-    return e;
-  };
-  Endpoint a = parse(from), b = parse(to);
-  Eigen::VectorXd fixed_seed;
-  if (!options.ik_seed_key.empty()) fixed_seed = scene.keyframe(options.ik_seed_key).q;
-  RobotState state(scene);
-  auto solve = [&](Endpoint& e, const Eigen::VectorXd& seed) {
-    e.ik = gripper_ik(state, e.position, fixed_seed.size() > 0 ? fixed_seed : seed, options.ik);
-    e.reachable = e.ik.success;
-    e.q = e.ik.q;
-  };
-  if (a.keyframe.empty()) solve(a, b.keyframe.empty() ? default_ik_seed(scene) : b.q);
-  if (b.keyframe.empty()) solve(b, a.q);
-  return {a, b};
-}
 
 void require_free(RobotState& state, const Eigen::VectorXd& q, double clearance, const std::string& what) {
   const Scene& scene = state.scene();
@@ -580,94 +486,6 @@ PlanResult plan_path(const Scene& scene, const Eigen::VectorXd& start, const Eig
   result.length = weighted_length(result.waypoints, checker->step(), options.resolution);
   result.checks = checker->checks();
   return result;
-}
-
-json path_json(const Scene& scene, const PlanResult& result, const PlanOptions& options, const Endpoint& from,
-               const Endpoint& to) {
-  json out;
-  out["format"] = "leeway-path-1";
-  out["units"] = "SI: metres, radians, seconds";
-  out["cell"] = scene.source();
-  out["joints"] = scene.joint_names();
-  json wps = json::array();
-  for (const auto& q : result.waypoints) wps.push_back({{"q", detail::to_json_array(q)}});
-  out["waypoints"] = wps;
-  out["from"] = endpoint_json(from);
-  out["to"] = endpoint_json(to);
-  out["planner"] = {
-      {"name", "RRTConnect"},
-      {"library", "OMPL " + std::to_string(OMPL_MAJOR_VERSION) + "." + std::to_string(OMPL_MINOR_VERSION) +
-                      "." + std::to_string(OMPL_PATCH_VERSION)},
-      {"method", result.method},
-      {"seed", options.seed},
-      {"time_limit", options.time_limit},
-      {"resolution", options.resolution},
-      {"slide_resolution", options.slide_resolution},
-      {"range", options.range},
-      {"clearance", options.clearance},
-      {"simplify", options.simplify},
-      {"try_direct", options.try_direct}};
-  out["simplified"] = result.simplified;
-  out["raw_waypoints"] = result.raw_waypoints;
-  out["length"] = result.length;
-  out["collision_checks"] = result.checks;
-  out["time"] = {{"plan", result.plan_seconds},
-                 {"simplify", result.simplify_seconds},
-                 {"total", result.plan_seconds + result.simplify_seconds}};
-  return out;
-}
-
-std::vector<Eigen::VectorXd> read_path(const std::string& path, const Scene& scene) {
-  const json j = detail::read_json_file(path, "path file");
-  auto fail = [&](const std::string& what) { throw InputError(path + ": " + what); };
-  try {
-    if (!j.is_object() || !j.contains("joints") || !j.contains("waypoints"))
-      fail("not a leeway path file (needs 'joints' and 'waypoints')");
-    if (j.contains("format")) {
-      const auto format = j.at("format").get<std::string>();
-      if (format != "leeway-path-1" && format != "leeway-bounds-1")
-        fail("format '" + format + "' is not a leeway path (leeway-path-1) or bounds file (leeway-bounds-1)");
-    }
-    const auto names = j.at("joints").get<std::vector<std::string>>();
-    if (names != scene.joint_names()) {
-      auto list = [](const std::vector<std::string>& v) {
-        std::string s;
-        for (const auto& n : v) s += (s.empty() ? "" : " ") + n;
-        return s;
-      };
-      fail("its joints '" + list(names) + "' do not match the robot in " + scene.source() + " ('" +
-           list(scene.joint_names()) + "')");
-    }
-    const auto& wps = j.at("waypoints");
-    if (!wps.is_array() || wps.size() < 2)
-      fail("'waypoints' must be a list of at least two waypoints, got " +
-           (wps.is_array() ? std::to_string(wps.size()) : std::string("a ") + wps.type_name()));
-    std::vector<Eigen::VectorXd> out;
-    for (size_t i = 0; i < wps.size(); ++i) {
-      const std::string where = "waypoint " + std::to_string(i);
-      if (!wps[i].is_object() || !wps[i].contains("q")) fail(where + " has no 'q'");
-      const auto& values = wps[i].at("q");
-      if (!values.is_array() || static_cast<int>(values.size()) != scene.dof())
-        fail(where + " 'q' has " + (values.is_array() ? std::to_string(values.size()) : std::string("no")) +
-             " values, the robot has " + std::to_string(scene.dof()) + " joints");
-      Eigen::VectorXd q(scene.dof());
-      for (int k = 0; k < scene.dof(); ++k) {
-        const auto& v = values[static_cast<size_t>(k)];
-        const RobotJoint& joint = scene.joints()[static_cast<size_t>(k)];
-        if (!v.is_number() || !std::isfinite(v.get<double>()))
-          fail(where + " joint '" + joint.name + "': " + v.dump() + " is not a finite number");
-        q[k] = v.get<double>();
-        if (q[k] < joint.lower || q[k] > joint.upper)
-          fail(where + " joint '" + joint.name + "' = " + format_number(q[k]) +
-               (joint.prismatic ? " m" : " rad") + " is outside its limits [" + format_number(joint.lower) +
-               ", " + format_number(joint.upper) + "]");
-      }
-      out.push_back(std::move(q));
-    }
-    return out;
-  } catch (const json::exception& e) {
-    throw InputError(path + ": unexpected content: " + e.what());
-  }
 }
 
 }  // namespace leeway

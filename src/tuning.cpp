@@ -7,13 +7,20 @@
 #include <filesystem>
 #include <limits>
 
+#include "statistics.hpp"
+
 #include "leeway/bounds.hpp"
+#include "leeway/cell_defaults.hpp"
 #include "leeway/confidence.hpp"
 #include "leeway/error.hpp"
 #include "leeway/kinematics.hpp"
+#include "leeway/nominal_path.hpp"
 
 namespace leeway {
 namespace {
+
+using detail::median;
+using detail::process_cpu_ms;
 
 // The tuned volume parameters, in tuned_variables() order (log10_max_cells comes after alpha_ng).
 struct VolumeField {
@@ -35,12 +42,6 @@ constexpr size_t kMarginIndex = kNumVolumeFields + 1;
 constexpr size_t kNumVariables = kNumVolumeFields + 2;
 
 }  // namespace
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n == 0 ? 0 : n % 2 ? v[n / 2] : (v[n / 2 - 1] + v[n / 2]) / 2;
-}
 
 std::string CaseSpec::label() const {
   return std::filesystem::path(cell).stem().string() + ":" + from + ":" + to;
@@ -270,12 +271,6 @@ double near_pairs(const Scene& scene, const std::vector<Eigen::VectorXd>& config
     }
   }
   return static_cast<double>(pairs) / static_cast<double>(configs.size());
-}
-
-double process_cpu_ms() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
 }
 
 TimedRun timed_bounds(TuningCase& c, const Params& params, int repeats) {

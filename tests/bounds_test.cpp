@@ -9,8 +9,10 @@
 #include <memory>
 #include <vector>
 
+#include "leeway/cell_defaults.hpp"
 #include "leeway/error.hpp"
 #include "leeway/kinematics.hpp"
+#include "leeway/nominal_path.hpp"
 #include "leeway/pipeline.hpp"
 #include "test_util.hpp"
 

@@ -8,8 +8,9 @@
 #include <sstream>
 #include <string>
 
+#include "leeway/endpoints.hpp"
 #include "leeway/kinematics.hpp"
-#include "leeway/planner.hpp"
+#include "leeway/nominal_path.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

@@ -16,8 +16,7 @@
 
 #include "leeway/error.hpp"
 #include "leeway/kinematics.hpp"
-#include "leeway/pipeline.hpp"
-#include "leeway/planner.hpp"
+#include "leeway/nominal_path.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

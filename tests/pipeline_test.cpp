@@ -1,5 +1,9 @@
 // The whole method on one path: keyframe paths, cell defaults, the bounds file and atomic writes.
 #include "leeway/pipeline.hpp"
+#include "leeway/bounds_file.hpp"
+#include "leeway/cell_defaults.hpp"
+#include "leeway/file_io.hpp"
+#include "leeway/nominal_path.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

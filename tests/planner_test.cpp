@@ -1,4 +1,6 @@
 #include "leeway/planner.hpp"
+#include "leeway/endpoints.hpp"
+#include "leeway/nominal_path.hpp"
 
 #include <gtest/gtest.h>
 

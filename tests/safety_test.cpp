@@ -10,7 +10,6 @@
 #include <string>
 
 #include "leeway/confidence.hpp"
-#include "leeway/pipeline.hpp"
 #include "leeway/safety.hpp"
 #include "test_util.hpp"
 

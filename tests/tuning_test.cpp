@@ -15,7 +15,9 @@
 #include <thread>
 
 #include "leeway/error.hpp"
+#include "leeway/nominal_path.hpp"
 #include "leeway/tuning.hpp"
+#include "statistics.hpp"
 #include "test_util.hpp"
 #include "tuner.hpp"
 
@@ -181,10 +183,10 @@ TEST(TunedVariablesTest, ConstraintsAreTheGapsOfBothPairs) {
 }
 
 TEST(MedianTest, OddEvenAndEmpty) {
-  EXPECT_EQ(median({3, 1, 2}), 2);
-  EXPECT_EQ(median({4, 1, 3, 2}), 2.5);
-  EXPECT_EQ(median({7}), 7);
-  EXPECT_EQ(median({}), 0);
+  EXPECT_EQ(detail::median({3, 1, 2}), 2);
+  EXPECT_EQ(detail::median({4, 1, 3, 2}), 2.5);
+  EXPECT_EQ(detail::median({7}), 7);
+  EXPECT_EQ(detail::median({}), 0);
 }
 
 TEST(TunedParamsJsonTest, HoldsTheTunedKeysOverTheBaseAndReadsBack) {

@@ -8,6 +8,7 @@
 #include <random>
 #include <sstream>
 
+#include "random.hpp"
 #include "test_util.hpp"
 
 namespace leeway {
@@ -74,9 +75,7 @@ TEST_F(VolumeWorldTest, GrownModelEqualsTheCompiledOne) {
 // Random boxes 1.2-3 m from the Dallara robot's base, 0.1-0.4 m across, 0.2 m to max_height high.
 std::vector<Box> random_boxes(int n, std::uint64_t seed, double max_height = 3.0) {
   std::mt19937_64 rng(seed);
-  auto u = [&](double lo, double hi) {
-    return lo + (hi - lo) * static_cast<double>(rng() >> 11) * 0x1.0p-53;
-  };
+  auto u = [&](double lo, double hi) { return lo + (hi - lo) * leeway::detail::unit(rng); };
   std::vector<Box> boxes;
   for (int i = 0; i < n; ++i) {
     Box b;
@@ -130,7 +129,7 @@ TEST_F(VolumeWorldTest, PoolContactsEqualAFreshlyCompiledModel) {
   int hits = 0;
   for (int k = 0; k < 500; ++k) {
     Eigen::VectorXd q(6);
-    for (int i = 0; i < 6; ++i) q[i] = lo[i] + (hi[i] - lo[i]) * static_cast<double>(rng() >> 11) * 0x1.0p-53;
+    for (int i = 0; i < 6; ++i) q[i] = lo[i] + (hi[i] - lo[i]) * leeway::detail::unit(rng);
     const bool pooled = checker.in_collision(q);
     for (int i = 0; i < 6; ++i) fd->qpos[i] = q[i];
     mj_kinematics(fresh.get(), fd.get());

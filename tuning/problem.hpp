@@ -13,8 +13,9 @@
 
 #include "leeway/confidence.hpp"
 #include "leeway/error.hpp"
-#include "leeway/pipeline.hpp"
+#include "leeway/file_io.hpp"
 #include "leeway/tuning.hpp"
+#include "random.hpp"
 
 namespace leeway::tune_cli {
 
@@ -95,8 +96,7 @@ struct Problem {
     for (int attempt = 0; attempt < 100000; ++attempt) {
       std::vector<double> x = start;
       for (size_t i = 0; i < size(); ++i)
-        if (!fixed[i])
-          x[i] = lower(i) + (upper(i) - lower(i)) * (static_cast<double>(rng() >> 11) * 0x1.0p-53);
+        if (!fixed[i]) x[i] = lower(i) + (upper(i) - lower(i)) * leeway::detail::unit(rng);
       if (leeway::meets_bound_constraints(x)) return x;
     }
     throw InputError("the variables' ranges leave almost no room for d_t_lb + " + num(leeway::kMinBoundGap) +

@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "stages.hpp"
+#include "statistics.hpp"
 
 namespace leeway::tune_cli {
 
@@ -174,7 +175,8 @@ std::optional<SearchResult> search(Problem& pb, std::ostream* log, double t0) {
         cpu.push_back(e.cpu_ms);
         if (e.cpu_ms > 0) rel.push_back(std::abs(e.cost_ms - e.cpu_ms) / e.cpu_ms);
       }
-    const double rho_cpu = spearman(cost, cpu), rho_wall = spearman(cost, wall), err = leeway::median(rel);
+    const double rho_cpu = spearman(cost, cpu), rho_wall = spearman(cost, wall),
+                 err = leeway::detail::median(rel);
     std::cout << "time proxy over the search's " << cost.size() << " runs: Spearman " << num(rho_cpu, 4)
               << " with CPU time, " << num(rho_wall, 4) << " with wall time; median relative error "
               << num(100 * err, 3) << " % (CPU)\n";

@@ -9,9 +9,17 @@
 #include "leeway/box.hpp"
 #include "leeway/params.hpp"
 #include "leeway/scene.hpp"
-#include "leeway/volume.hpp"
 
 namespace leeway {
+
+//! The categorised obstacles of section 3.1, as boxes in world coordinates.
+struct Categories {
+  std::optional<Box> goal;                //!< the goal obstacle (Algorithm 1), if any
+  int goal_geom = -1;                     //!< its geom id in the scene (-1 when none or not from a scene)
+  std::vector<Box> non_goal;              //!< every other obstacle
+  std::vector<Box> trail;                 //!< robot link boxes at every (densified) path pose
+  std::vector<Eigen::Vector2d> arm_base;  //!< arm-base position in the floor plane at every path pose
+};
 
 //! Algorithm 1 (Identify Goal Obstacle): starting at the end-effector goal point, descend along
 //! world z in steps of dz while z > 0 and return the index of the first obstacle box that contains

@@ -1,15 +1,13 @@
 #pragma once
 //! @file pipeline.hpp
-//! The whole method on one path: categorise, generate the volume, inject it, bound every waypoint;
-//! the bounds file format; atomic output files.
+//! The whole method on one path: categorise, generate the volume, inject it, bound every waypoint,
+//! then the safety stage.
 
 #include <Eigen/Core>
-#include <nlohmann/json.hpp>
-#include <string>
 #include <vector>
 
 #include "leeway/bounds.hpp"
-#include "leeway/confidence.hpp"
+#include "leeway/categorize.hpp"
 #include "leeway/params.hpp"
 #include "leeway/safety.hpp"
 #include "leeway/scene.hpp"
@@ -17,16 +15,6 @@
 #include "leeway/volume_world.hpp"
 
 namespace leeway {
-
-//! Cell-specific defaults read from MJCF custom numerics (docs/mjcf-conventions.md):
-//! `leeway_reach_radius` [m] and `leeway_add_obstacle_boxes` (0 or 1). Applied to `params`.
-//! @throws InputError on a non-finite or out-of-range value.
-void apply_cell_defaults(const Scene& scene, Params& params);
-
-//! A path between two keyframes: `waypoints` >= 2 configurations joined linearly in joint space
-//! (the thesis's paths are its two end points). @throws InputError on unknown names or waypoints < 2.
-std::vector<Eigen::VectorXd> keyframe_path(const Scene& scene, const std::string& from, const std::string& to,
-                                           int waypoints);
 
 //! Everything one run produces, with the time of each stage [ms].
 struct BoundsRun {
@@ -44,25 +32,5 @@ struct BoundsRun {
 //! @throws InputError on invalid parameters or waypoints.
 BoundsRun compute_bounds(const Scene& scene, VolumeModel& world, const std::vector<Eigen::VectorXd>& path,
                          const Params& params, int threads);
-
-//! The safety stage's record in a bounds file: mode, whether every segment passed, per segment
-//! leaves/depth (certified) or samples/rounds (sampled), margin or epsilon, delta and N.
-nlohmann::json safety_json(const SafetyReport& report, const SafetyParams& params);
-
-//! The "format" value of the bounds files bounds_json writes and read_bounds accepts.
-inline constexpr const char* kBoundsFormat = "leeway-bounds-1";
-
-//! The bounds file (docs/cli.md): joints, waypoints (q, lower, upper), boxes, max_cells, timing_ms...
-nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Params& params);
-
-//! Reads a bounds file written for `scene`: q, lower, upper and collapsed of every waypoint (the
-//! guide bounds and checks are not read). A file without "format" is accepted (older files).
-//! @throws InputError naming the file and the mismatch (a "format" other than kBoundsFormat, other
-//! joints, wrong sizes, NaN, lower > upper, nominal outside its bounds, an unknown collapsed joint).
-std::vector<WaypointBounds> read_bounds(const std::string& path, const Scene& scene);
-
-//! Writes text to a temporary file beside `path`, then renames it: no partial file on failure.
-//! @throws InputError naming the file when it cannot be written.
-void write_file_atomic(const std::string& path, const std::string& text);
 
 }  // namespace leeway

@@ -3,14 +3,12 @@
 //! The global planner (issue #4): the nominal path between two gripper positions, as in the thesis
 //! (chapter 3: "The development and testing of the algorithm were done using RRT-connect as a
 //! global planner"; section 4.1: the global planner takes "into input the starting and the goal
-//! position of the robot gripper"). Endpoints are keyframes, goal sites or
-//! points (inverse kinematics with the linear-axis policy first); OMPL's RRT-Connect plans in joint
-//! space over every robot joint against the real obstacles, OMPL's simplifier shortens the path,
-//! and leeway re-checks every edge. The path file format. docs/planning.md explains the guarantees.
+//! position of the robot gripper"). OMPL's RRT-Connect plans in joint space over every robot joint
+//! against the real obstacles, OMPL's simplifier shortens the path, and leeway re-checks every edge.
+//! docs/planning.md explains the guarantees; endpoints.hpp resolves the path's ends.
 
 #include <Eigen/Core>
 #include <cstdint>
-#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -18,54 +16,6 @@
 #include "leeway/scene.hpp"
 
 namespace leeway {
-
-//! The linear-axis policy for a gripper goal: returns `q` with every slide joint moved so that the
-//! arm base (the first hinge joint's anchor, as in categorize()) is abeam of `goal` along the
-//! slide's axis: value = axis . (goal - base at slide value 0), clamped to the slide's limits. For
-//! a rail along world x with the arm base at x = 0 when the rail is at 0 (the DLR cell), the rail
-//! goes to the goal's x. Slides are placed in model order, so orthogonal slides (a gantry) each
-//! take their own component. Without a hinge joint the tool site stands in for the arm base.
-//! Hinge joints keep their values from `q`.
-//! @throws InputError when `q` has the wrong size or is not finite, or `goal` is not finite.
-Eigen::VectorXd place_slides(const Scene& scene, const Eigen::Vector3d& goal, const Eigen::VectorXd& q);
-
-//! Inverse kinematics for a gripper goal: the slides placed by place_slides() and locked, then
-//! solve_ik() over the other joints (tool pointing down unless `options.tool_down` is false,
-//! within the limits, collision-free, nearest `seed`). `options.locked` is overridden for slides
-//! and kept for the other joints. The returned IkResult says whether it converged.
-//! @throws InputError as solve_ik().
-IkResult gripper_ik(RobotState& state, const Eigen::Vector3d& goal, const Eigen::VectorXd& seed,
-                    IkOptions options = {});
-
-//! World position of a goal site [m]. @throws InputError listing the goal sites when unknown.
-Eigen::Vector3d site_position(const Scene& scene, const std::string& name);
-
-//! One end of a path, resolved from its text form (resolve_endpoints()).
-struct Endpoint {
-  std::string spec;                                    //!< as given: "home", "site:mould", "xyz:1,2,0.8"
-  std::string keyframe;                                //!< the keyframe's name, or "" for a gripper goal
-  std::string site;                                    //!< the goal site's name for "site:NAME", else ""
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();  //!< gripper goal [m] (sites and points only)
-  bool reachable = true;                               //!< false when inverse kinematics found no solution
-  Eigen::VectorXd q;                                   //!< the configuration (the closest one if unreachable)
-  IkResult ik;                                         //!< the IK result (sites and points only)
-};
-
-//! Options of resolve_endpoints().
-struct EndpointOptions {
-  std::string ik_seed_key;  //!< keyframe seeding every IK; "" = the policy of resolve_endpoints()
-  IkOptions ik;             //!< restarts, RNG seed, tolerances (tool down and collision-free by default)
-};
-
-//! Resolves `from` and `to`. Each is a keyframe name, "site:NAME" (a goal site) or "xyz:X,Y,Z" (a
-//! gripper position [m]). Gripper goals go through gripper_ik(), seeded (unless
-//! options.ik_seed_key names a keyframe) with the other end when that is a keyframe, so the goal
-//! configuration is the one nearest the start; when both are gripper goals `from` is seeded with
-//! the first keyframe (or the joint values nearest zero within the limits) and `to` with `from`'s
-//! solution. An unreachable goal is returned with reachable = false, not thrown.
-//! @throws InputError on an unknown keyframe or site, a malformed spec or a bad IK seed key.
-std::pair<Endpoint, Endpoint> resolve_endpoints(const Scene& scene, const std::string& from,
-                                                const std::string& to, const EndpointOptions& options = {});
 
 //! Parameters of plan_path(). Every value is SI (seconds, radians, metres).
 struct PlanOptions {
@@ -132,15 +82,5 @@ bool edge_is_free(RobotState& state, const Eigen::VectorXd& a, const Eigen::Vect
 //! closer to an obstacle than `clearance`. @throws InputError naming `what`, the joint or the link,
 //! obstacle and depth or distance.
 void require_free(RobotState& state, const Eigen::VectorXd& q, double clearance, const std::string& what);
-
-//! The path file (docs/planning.md): format "leeway-path-1", units, cell, joints, waypoints (each
-//! with q), from / to, planner settings and statistics.
-nlohmann::json path_json(const Scene& scene, const PlanResult& result, const PlanOptions& options,
-                         const Endpoint& from, const Endpoint& to);
-
-//! Reads a path file (written by path_json) for `scene`.
-//! @throws InputError naming the file and the mismatch: not a path file, other joints, fewer than
-//! two waypoints, a wrong number of values, a value that is not a finite number, outside the limits.
-std::vector<Eigen::VectorXd> read_path(const std::string& path, const Scene& scene);
 
 }  // namespace leeway

@@ -99,9 +99,6 @@ std::vector<double> bound_constraints(const std::vector<double>& x);
 //! True when x meets both constraints of bound_constraints() (each value <= 0).
 bool meets_bound_constraints(const std::vector<double>& x);
 
-//! Median of `v`; 0 for an empty vector.
-double median(std::vector<double> v);
-
 //! Link-geom/box pairs whose bounding spheres overlap, averaged over the configurations: how many
 //! pairs of one collision check near these configurations get past MuJoCo's bounding-sphere test to
 //! the box-box test, the part of a check's cost that the box count alone does not predict.
@@ -140,9 +137,6 @@ struct TimingSample {
 //! subsets of terms whose unconstrained fit is non-negative). @throws InputError on fewer than 2
 //! samples.
 TimeModel fit_time_model(const std::vector<TimingSample>& samples);
-
-//! Process CPU time [ms] (all threads), for timing single-threaded work on a shared machine.
-double process_cpu_ms();
 
 //! One single-threaded compute_bounds run with its wall and process CPU times [ms].
 struct TimedRun {

@@ -4,22 +4,13 @@
 //! height is the height function (eq. 3.1 with eq. 4.1), zero beyond reach and under the trail.
 
 #include <Eigen/Core>
-#include <optional>
 #include <vector>
 
 #include "leeway/box.hpp"
+#include "leeway/categorize.hpp"
 #include "leeway/params.hpp"
 
 namespace leeway {
-
-//! The categorised obstacles of section 3.1, as boxes in world coordinates.
-struct Categories {
-  std::optional<Box> goal;                //!< the goal obstacle (Algorithm 1), if any
-  int goal_geom = -1;                     //!< its geom id in the scene (-1 when none or not from a scene)
-  std::vector<Box> non_goal;              //!< every other obstacle
-  std::vector<Box> trail;                 //!< robot link boxes at every (densified) path pose
-  std::vector<Eigen::Vector2d> arm_base;  //!< arm-base position in the floor plane at every path pose
-};
 
 //! The resolved grid: cell (i, j) has centre (origin_x + (i + 0.5) * side, origin_y + (j + 0.5) * side).
 struct Grid {

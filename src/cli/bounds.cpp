@@ -5,8 +5,13 @@
 #include <sstream>
 #include <utility>
 
+#include "leeway/bounds_file.hpp"
+#include "leeway/endpoints.hpp"
+#include "leeway/file_io.hpp"
+#include "leeway/nominal_path.hpp"
 #include "leeway/path_check.hpp"
 #include "leeway/pipeline.hpp"
+#include "leeway/planner.hpp"
 
 namespace leeway::cli {
 namespace {

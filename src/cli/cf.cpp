@@ -3,7 +3,7 @@
 #include <iomanip>
 #include <iostream>
 
-#include "leeway/pipeline.hpp"
+#include "leeway/bounds_file.hpp"
 
 namespace leeway::cli {
 

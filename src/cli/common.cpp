@@ -5,7 +5,9 @@
 #include <tuple>
 
 #include "json_io.hpp"
-#include "leeway/pipeline.hpp"
+#include "leeway/cell_defaults.hpp"
+#include "leeway/endpoints.hpp"
+#include "leeway/planner.hpp"
 
 namespace leeway::cli {
 

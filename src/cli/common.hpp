@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 
+#include "leeway/endpoints.hpp"
 #include "leeway/error.hpp"
 #include "leeway/params.hpp"
 #include "leeway/planner.hpp"

@@ -2,7 +2,7 @@
 
 #include <iostream>
 
-#include "leeway/pipeline.hpp"
+#include "leeway/cell_defaults.hpp"
 
 namespace leeway::cli {
 

@@ -3,7 +3,10 @@
 #include <iomanip>
 #include <iostream>
 
-#include "leeway/pipeline.hpp"
+#include "leeway/endpoints.hpp"
+#include "leeway/file_io.hpp"
+#include "leeway/nominal_path.hpp"
+#include "leeway/planner.hpp"
 
 namespace leeway::cli {
 

@@ -6,6 +6,8 @@
 #include <iostream>
 #include <sstream>
 
+#include "leeway/file_io.hpp"
+#include "leeway/nominal_path.hpp"
 #include "leeway/path_check.hpp"
 #include "leeway/pipeline.hpp"
 #include "leeway/tuning.hpp"

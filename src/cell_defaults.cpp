@@ -1,0 +1,34 @@
+#include "leeway/cell_defaults.hpp"
+
+#include <cmath>
+
+#include "leeway/error.hpp"
+
+namespace leeway {
+
+void apply_cell_defaults(const Scene& scene, Params& params) {
+  const mjModel& m = scene.model();
+  auto numeric = [&](const char* name, double& out) {
+    const int id = mj_name2id(&m, mjOBJ_NUMERIC, name);
+    if (id < 0) return false;
+    if (m.numeric_size[id] < 1 || !std::isfinite(m.numeric_data[m.numeric_adr[id]]))
+      throw InputError(scene.source() + ": custom numeric '" + name + "' must hold one finite number");
+    out = m.numeric_data[m.numeric_adr[id]];
+    return true;
+  };
+  double v = 0;
+  if (numeric("leeway_reach_radius", v)) {
+    if (v <= 0)
+      throw InputError(scene.source() + ": custom numeric 'leeway_reach_radius' = " + format_number(v) +
+                       " must be > 0 m");
+    params.volume.reach_radius = v;
+  }
+  if (numeric("leeway_add_obstacle_boxes", v)) {
+    if (v != 0 && v != 1)
+      throw InputError(scene.source() + ": custom numeric 'leeway_add_obstacle_boxes' = " + format_number(v) +
+                       " must be 0 or 1");
+    params.volume.add_obstacle_boxes = v == 1;
+  }
+}
+
+}  // namespace leeway

@@ -167,6 +167,7 @@ void Scene::recognise(const SceneOptions& options) {
                      "(contype or conaffinity must be non-zero)");
 
   // Sites: the tool site in the robot, goal sites outside it.
+  checker_ = options.checker;
   tool_site_ = mj_name2id(&m, mjOBJ_SITE, options.tool_site.c_str());
   if (tool_site_ < 0)
     throw InputError(file + ": no site named '" + options.tool_site +
@@ -192,6 +193,15 @@ void Scene::recognise(const SceneOptions& options) {
                          format_number(kf.q[i]) + "', not a finite number");
     keyframes_.push_back(std::move(kf));
   }
+
+  // The static side of every robot-versus-obstacle check: every geom that is not a link, at its
+  // pose at qpos0 (none of them moves with the robot's joints), indexed for the midphase.
+  DataPtr d = make_data(m);
+  mj_kinematics(&m, d.get());
+  std::vector<int> statics;
+  for (int g = 0; g < m.ngeom; ++g)
+    if (roles_[static_cast<size_t>(g)] != GeomRole::kLink) statics.push_back(g);
+  statics_.build(m, *d, statics);
 }
 
 std::vector<std::string> Scene::joint_names() const {

@@ -2,13 +2,13 @@
 
 #include <algorithm>
 #include <cstring>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 
 #include <mujoco/mjxmacro.h>
 
+#include "leeway/collision.hpp"
 #include "leeway/error.hpp"
 
 namespace leeway {
@@ -146,50 +146,77 @@ ModelPtr grow_last_body_geoms(const mjModel& m, int extra) {
   return grown;
 }
 
-VolumeModel::VolumeModel(const Scene& scene, int capacity) : scene_(&scene) {
-  install_mujoco_error_handlers();
-  if (capacity < 1) throw InputError("volume pool capacity " + std::to_string(capacity) + " must be >= 1");
-  const std::string& path = scene.source();
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot read the cell again to add the volume pool");
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string xml = text.str();
-  const size_t close = xml.rfind("</worldbody>");
-  if (close == std::string::npos)
-    throw InputError(path + ": has no </worldbody> in the main file; leeway adds its volume body there");
-  // A static body at the world origin, last in the tree, so its geoms are the model's last geoms.
-  xml.insert(close, std::string("<body name=\"") + kVolumeBodyName +
-                        "\"><geom name=\"leeway_volume_template\" type=\"box\" size=\"0.001 0.001 0.001\" "
-                        "contype=\"0\" conaffinity=\"0\" group=\"5\" rgba=\"0.2 0.5 1 0.4\"/></body>");
-  // Compile from a virtual file named next to the cell so that its relative includes resolve.
+namespace {
+
+// The volume model's MJCF: the robot's link geoms (their types and sizes; poses are written per
+// check) on one free body, and a static body holding `pool` template box geoms. Built from the
+// scene's compiled model, so it needs neither the cell's file nor its includes. A mesh or height
+// field link is represented by its bounding box (geom_box).
+std::string pool_xml(const Scene& scene, int pool) {
+  const mjModel& m = scene.model();
+  std::ostringstream x;
+  x.precision(17);
+  x << "<mujoco model=\"leeway volume model\"><worldbody><body name=\"leeway_robot\"><freejoint/>";
+  for (int g : scene.link_geoms()) {
+    const int type = m.geom_type[g];
+    const mjtNum* size = m.geom_size + 3 * g;
+    x << "<geom contype=\"1\" conaffinity=\"0\" margin=\"" << m.geom_margin[g] << "\" ";
+    switch (type) {
+      case mjGEOM_SPHERE:
+        x << "type=\"sphere\" size=\"" << size[0] << "\"/>";
+        break;
+      case mjGEOM_CAPSULE:
+        x << "type=\"capsule\" size=\"" << size[0] << " " << size[1] << "\"/>";
+        break;
+      case mjGEOM_CYLINDER:
+        x << "type=\"cylinder\" size=\"" << size[0] << " " << size[1] << "\"/>";
+        break;
+      case mjGEOM_ELLIPSOID:
+        x << "type=\"ellipsoid\" size=\"" << size[0] << " " << size[1] << " " << size[2] << "\"/>";
+        break;
+      case mjGEOM_BOX:
+        x << "type=\"box\" size=\"" << size[0] << " " << size[1] << " " << size[2] << "\"/>";
+        break;
+      default: {  // mesh, height field: the bounding box
+        const double r = m.geom_rbound[g] > 0 ? m.geom_rbound[g] : 1.0;
+        x << "type=\"box\" size=\"" << r << " " << r << " " << r << "\"/>";
+      }
+    }
+  }
+  x << "</body><body name=\"" << kVolumeBodyName << "\">";
+  for (int i = 0; i < pool; ++i)
+    x << "<geom type=\"box\" size=\"0.001 0.001 0.001\" contype=\"0\" conaffinity=\"0\" group=\"5\" "
+         "rgba=\"0.2 0.5 1 0.4\"/>";
+  x << "</body></worldbody></mujoco>";
+  return x.str();
+}
+
+ModelPtr compile_xml(const std::string& xml, const std::string& what) {
   auto vfs = std::make_unique<mjVFS>();
   mj_defaultVFS(vfs.get());
-  const std::string vname = path + ".leeway-volume.xml";
-  if (mj_makeEmptyFileVFS(vfs.get(), vname.c_str(), static_cast<int>(xml.size())) != 0)
+  const char* name = "leeway-volume-model.xml";
+  if (mj_makeEmptyFileVFS(vfs.get(), name, static_cast<int>(xml.size())) != 0)
     throw std::runtime_error("cannot allocate a MuJoCo VFS file");
   std::memcpy(vfs->filedata[vfs->nfile - 1], xml.data(), xml.size());
   char error[1024] = "";
-  mjModel* m = mj_loadXML(vname.c_str(), vfs.get(), error, sizeof(error));
+  mjModel* m = mj_loadXML(name, vfs.get(), error, sizeof(error));
   mj_deleteVFS(vfs.get());
-  if (!m) throw InputError(path + ": does not compile with the volume body added: " + std::string(error));
-  model_.reset(m);
   take_mujoco_warnings();
+  if (!m) throw InputError(what + ": the volume model does not compile: " + std::string(error));
+  return ModelPtr(m);
+}
 
-  const mjModel& small = scene.model();
-  pool_body_ = mj_name2id(m, mjOBJ_BODY, kVolumeBodyName);
-  if (pool_body_ != m->nbody - 1 || m->ngeom != small.ngeom + 1 || m->geom_bodyid[m->ngeom - 1] != pool_body_)
-    throw InputError(path +
-                     ": leeway cannot place its volume body last in the model (is there a body named '" +
-                     kVolumeBodyName + "' already?)");
-  for (int g = 0; g < small.ngeom; ++g) {
-    LEEWAY_DEMAND(m->geom_type[g] == small.geom_type[g] && m->geom_bodyid[g] == small.geom_bodyid[g]);
-    // Links as the scene normalised them; obstacles and everything else off: the volume decides.
-    const bool link = scene.role(g) == GeomRole::kLink;
-    m->geom_contype[g] = link ? 1 : 0;
-    m->geom_conaffinity[g] = 0;
-  }
-  first_pool_geom_ = m->ngeom - 1;
+}  // namespace
+
+VolumeModel::VolumeModel(const Scene& scene, int capacity) : scene_(&scene) {
+  if (capacity < 1) throw InputError("volume pool capacity " + std::to_string(capacity) + " must be >= 1");
+  model_ = compile_xml(pool_xml(scene, 1), scene.source());
+  small_ = ModelPtr(mj_copyModel(nullptr, model_.get()));
+  const mjModel& m = *model_;
+  pool_body_ = mj_name2id(&m, mjOBJ_BODY, kVolumeBodyName);
+  LEEWAY_DEMAND(pool_body_ == m.nbody - 1 && m.ngeom == static_cast<int>(scene.link_geoms().size()) + 1);
+  for (int k = 0; k < static_cast<int>(scene.link_geoms().size()); ++k) link_geoms_.push_back(k);
+  first_pool_geom_ = m.ngeom - 1;
   capacity_ = 1;
   active_ = 1;  // the template, until set_boxes()
   grow(capacity);
@@ -202,7 +229,14 @@ void VolumeModel::grow(int capacity) {
   if (capacity <= capacity_) return;
   model_->ngeom = first_pool_geom_ + capacity_;  // the whole pool, as compiled
   model_->body_geomnum[pool_body_] = capacity_;
-  model_ = grow_last_body_geoms(*model_, capacity - capacity_);
+  try {
+    model_ = grow_last_body_geoms(*model_, capacity - capacity_);
+  } catch (const std::runtime_error&) {
+    // Another MuJoCo's binary layout: compile the pool from XML instead (quadratic in the pool
+    // size, shared/notes/mujoco-2.2.2.md, but correct).
+    model_ = compile_xml(pool_xml(*scene_, capacity), scene_->source());
+    pool_body_ = mj_name2id(model_.get(), mjOBJ_BODY, kVolumeBodyName);
+  }
   capacity_ = capacity;
   model_->body_geomnum[pool_body_] = active_;
   model_->ngeom = first_pool_geom_ + active_;
@@ -211,18 +245,25 @@ void VolumeModel::grow(int capacity) {
 
 void VolumeModel::set_boxes(const std::vector<Box>& boxes) {
   const int n = static_cast<int>(boxes.size());
+  for (int i = 0; i < n; ++i) {
+    const Box& b = boxes[static_cast<size_t>(i)];
+    if (!b.center.allFinite() || !b.half_size.allFinite() || !b.rotation.allFinite() ||
+        (b.half_size.array() <= 0).any())
+      throw InputError("volume box #" + std::to_string(i) + " has a non-finite or non-positive size");
+  }
   if (n > capacity_) {
     int grown = capacity_;
     while (grown < n) grown *= 2;
     grow(grown);
   }
   mjModel& m = *model_;
+  std::vector<Aabb> aabbs(static_cast<size_t>(n));
+  pool_xpos_.resize(3 * static_cast<size_t>(n));
+  pool_xmat_.resize(9 * static_cast<size_t>(n));
   for (int i = 0; i < capacity_; ++i) {
     const int g = first_pool_geom_ + i;
     if (i < n) {
       const Box& b = boxes[static_cast<size_t>(i)];
-      if (!b.center.allFinite() || !b.half_size.allFinite() || (b.half_size.array() <= 0).any())
-        throw InputError("volume box #" + std::to_string(i) + " has a non-finite or non-positive size");
       Eigen::Matrix<double, 3, 3, Eigen::RowMajor> r = b.rotation;
       mju_mat2Quat(m.geom_quat + 4 * g, r.data());
       for (int k = 0; k < 3; ++k) {
@@ -233,6 +274,14 @@ void VolumeModel::set_boxes(const std::vector<Box>& boxes) {
       m.geom_sameframe[g] = 0;
       m.geom_contype[g] = 0;
       m.geom_conaffinity[g] = 1;
+      // mj_kinematics on the static pool body (identity pose): xpos = pos, xmat from the quaternion.
+      for (int k = 0; k < 3; ++k)
+        pool_xpos_[3 * static_cast<size_t>(i) + static_cast<size_t>(k)] = b.center[k];
+      mju_quat2Mat(pool_xmat_.data() + 9 * i, m.geom_quat + 4 * g);
+      // The pool body is the static world frame: the geom's world box is the box itself (the
+      // quaternion round trip differs from b.rotation by rounding, far below the grid's 1e-9 m).
+      const Eigen::Vector3d e = b.rotation.cwiseAbs() * b.half_size;
+      aabbs[static_cast<size_t>(i)] = {b.center - e, b.center + e};
     } else {
       m.geom_contype[g] = 0;
       m.geom_conaffinity[g] = 0;
@@ -244,6 +293,10 @@ void VolumeModel::set_boxes(const std::vector<Box>& boxes) {
   m.body_geomnum[pool_body_] = n;
   m.ngeom = first_pool_geom_ + n;
   active_ = n;
+  pool_.grid.build(aabbs);
+  pool_.geoms.resize(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) pool_.geoms[static_cast<size_t>(i)] = first_pool_geom_ + i;
+  pool_.max_margin = 0;
   ++generation_;
 }
 
@@ -255,43 +308,69 @@ DataPtr VolumeModel::make_data() const {
 }
 
 VolumeChecker::VolumeChecker(const VolumeModel& world)
-    : world_(&world), robot_(world.scene()), data_(world.make_data()), data_capacity_(world.capacity()) {
-  const Scene& scene = world.scene();
-  const mjModel& small = scene.model();
-  for (int b = 1; b < small.nbody; ++b)
-    if (small.body_weldid[b] != 0) robot_bodies_.push_back(b);
-  robot_geoms_ = scene.link_geoms();
+    : world_(&world), robot_(world.scene()), checker_(world.scene().checker()) {
+  if (!emulates_mj_collision(world.model())) checker_ = CollisionChecker::kMujoco;
+  if (checker_ == CollisionChecker::kMidphase) {
+    small_ = ModelPtr(mj_copyModel(nullptr, &world.narrowphase_model()));
+    small_data_ = make_data(*small_);
+  }
 }
 
 void VolumeChecker::refresh() {
-  if (data_capacity_ != world_->capacity()) {  // the pool grew: the model was rebuilt
-    data_ = world_->make_data();
-    data_capacity_ = world_->capacity();
+  // The mujoco checker's data: sized for the whole pool, the static geoms placed once per volume.
+  if (checker_ == CollisionChecker::kMujoco) {
+    if (!data_ || data_capacity_ != world_->capacity()) {  // new, or the pool grew
+      data_ = world_->make_data();
+      data_capacity_ = world_->capacity();
+    }
+    mj_kinematics(&world_->model(), data_.get());
   }
-  // Static geoms (the pool, obstacles) are placed once per volume.
-  mj_kinematics(&world_->model(), data_.get());
   generation_ = world_->generation();
+}
+
+bool VolumeChecker::midphase_collision() {
+  // The link geoms' poses, then every candidate box written into the template geom in turn.
+  mjModel& m = *small_;
+  mjData& d = *small_data_;
+  const mjModel& pool = world_->model();
+  const int slot = m.ngeom - 1;
+  const std::vector<int>& links = world_->link_geoms();
+  const StaticGeoms& boxes = world_->pool();
+  for (int g : links) {
+    Aabb q = geom_aabb(m, d, g);
+    q.lo.array() -= m.geom_margin[g];
+    q.hi.array() += m.geom_margin[g];
+    const bool hit = boxes.grid.any(q, [&](int i) {
+      const int p = boxes.geoms[static_cast<size_t>(i)];
+      std::memcpy(m.geom_size + 3 * slot, pool.geom_size + 3 * p, 3 * sizeof(mjtNum));
+      m.geom_rbound[slot] = pool.geom_rbound[p];
+      m.geom_contype[slot] = pool.geom_contype[p];
+      m.geom_conaffinity[slot] = pool.geom_conaffinity[p];
+      m.geom_margin[slot] = pool.geom_margin[p];
+      std::memcpy(d.geom_xpos + 3 * slot, world_->pool_xpos(i), 3 * sizeof(mjtNum));
+      std::memcpy(d.geom_xmat + 9 * slot, world_->pool_xmat(i), 9 * sizeof(mjtNum));
+      return geoms_in_contact(m, d, g, slot);
+    });
+    if (hit) return true;
+  }
+  return false;
 }
 
 bool VolumeChecker::in_collision(const Eigen::VectorXd& q) {
   if (generation_ != world_->generation()) refresh();
   robot_.set(q);
   const mjData& s = robot_.data();
-  mjData& d = *data_;
-  for (int b : robot_bodies_) {
-    std::memcpy(d.xpos + 3 * b, s.xpos + 3 * b, 3 * sizeof(mjtNum));
-    std::memcpy(d.xquat + 4 * b, s.xquat + 4 * b, 4 * sizeof(mjtNum));
-    std::memcpy(d.xmat + 9 * b, s.xmat + 9 * b, 9 * sizeof(mjtNum));
-    std::memcpy(d.xipos + 3 * b, s.xipos + 3 * b, 3 * sizeof(mjtNum));
-    std::memcpy(d.ximat + 9 * b, s.ximat + 9 * b, 9 * sizeof(mjtNum));
+  mjData& d = checker_ == CollisionChecker::kMidphase ? *small_data_ : *data_;
+  const std::vector<int>& links = world_->scene().link_geoms();
+  for (size_t k = 0; k < links.size(); ++k) {
+    const int from = links[k], to = world_->link_geoms()[k];
+    std::memcpy(d.geom_xpos + 3 * to, s.geom_xpos + 3 * from, 3 * sizeof(mjtNum));
+    std::memcpy(d.geom_xmat + 9 * to, s.geom_xmat + 9 * from, 9 * sizeof(mjtNum));
   }
-  for (int g : robot_geoms_) {
-    std::memcpy(d.geom_xpos + 3 * g, s.geom_xpos + 3 * g, 3 * sizeof(mjtNum));
-    std::memcpy(d.geom_xmat + 9 * g, s.geom_xmat + 9 * g, 9 * sizeof(mjtNum));
-  }
+  ++checks_;
+  if (checker_ == CollisionChecker::kMidphase) return midphase_collision();
   mj_collision(&world_->model(), &d);
   take_mujoco_warnings();  // a full contact buffer still answers "in collision"
-  ++checks_;
   return d.ncon > 0;
 }
 

@@ -50,7 +50,9 @@ class RobotState {
     set(q);
     return tool_pose();
   }
-  //! True when a robot link touches or penetrates an obstacle at q.
+  //! True when a robot link touches or penetrates an obstacle at q: mj_collision's answer, from the
+  //! scene's checker (Scene::checker(): the midphase adds no contacts to data(); use contacts()
+  //! for them).
   bool in_collision(const Eigen::VectorXd& q);
   //! All robot-link-versus-obstacle contacts at q (deepest first).
   std::vector<Contact> contacts(const Eigen::VectorXd& q);

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "leeway/collision.hpp"
 #include "leeway/mujoco_util.hpp"
 
 namespace leeway {
@@ -38,6 +39,9 @@ struct Keyframe {
 //! Options for recognising the scene.
 struct SceneOptions {
   std::string tool_site = "tool0";  //!< the site at the robot's flange
+  //! Which pipeline answers every collision check against this scene and its volume: the midphase
+  //! (default) or MuJoCo's full mj_collision pass (the reference; collision.hpp).
+  CollisionChecker checker = CollisionChecker::kMidphase;
 };
 
 //! A loaded, recognised workcell. Owns its mjModel, whose collision bitmasks are normalised so that
@@ -70,6 +74,10 @@ class Scene {
   std::string geom_label(int geom) const;
 
   int tool_site() const { return tool_site_; }
+  //! The collision checker chosen at load (SceneOptions::checker).
+  CollisionChecker checker() const { return checker_; }
+  //! Every geom that is not a link, indexed for the midphase at its (fixed) pose.
+  const StaticGeoms& statics() const { return statics_; }
   const std::vector<int>& goal_sites() const { return goal_sites_; }
   //! Site id of a goal site. @throws InputError listing the goal sites when unknown.
   int goal_site(const std::string& name) const;
@@ -99,6 +107,8 @@ class Scene {
   std::vector<GeomRole> roles_;
   std::vector<int> link_geoms_, base_geoms_, obstacle_geoms_;
   int tool_site_ = -1;
+  CollisionChecker checker_ = CollisionChecker::kMidphase;
+  StaticGeoms statics_;
   std::vector<int> goal_sites_;
   std::vector<Keyframe> keyframes_;
 };

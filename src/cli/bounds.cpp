@@ -62,6 +62,7 @@ CLI::App* add_bounds(CLI::App& app, BoundsArgs& args) {
       "keyframes is planned around (RRT-Connect). Exit 0 on success, 1 a colliding path, an unreachable\n"
       "goal or no path, 2 bad input.");
   sub->add_option("cell", args.cell, "MJCF file of the workcell")->required();
+  add_checker_option(sub, args.checker);
   auto* path_opt =
       sub->add_option("--path", args.path, "Path file written by leeway plan --out (instead of --from/--to)");
   sub->add_option("--from", args.from, "Start: a keyframe, site:NAME or xyz:X,Y,Z")->excludes(path_opt);
@@ -90,7 +91,7 @@ CLI::App* add_bounds(CLI::App& app, BoundsArgs& args) {
 }
 
 int run_bounds(const BoundsArgs& args) {
-  const auto scene = Scene::load(args.cell, scene_options(kDefaultTool));
+  const auto scene = Scene::load(args.cell, scene_options(kDefaultTool, args.checker));
   Params p = load_params(scene, args.preset, args.params, args.safety);
   if (args.max_cells_given) p.height_map.max_cells = args.max_cells;
   p.validate();

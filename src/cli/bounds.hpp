@@ -11,22 +11,23 @@ namespace leeway::cli {
 
 //! The command line of `leeway bounds`.
 struct BoundsArgs {
-  std::string cell;                 //!< MJCF file of the workcell
-  std::string from, to;             //!< path ends: keyframe, site:NAME or xyz:X,Y,Z
-  std::string path;                 //!< a path file instead of from/to
-  std::string ik_seed;              //!< keyframe seeding the IK of gripper goals
-  std::string params;               //!< parameter file (JSON)
-  std::string preset = "leeway";    //!< parameter set
-  std::string safety;               //!< safety mode; empty: the preset's
-  std::string out;                  //!< bounds file to write (JSON); empty: none
-  int max_cells = 0;                //!< MAX_cells, used when max_cells_given
-  bool max_cells_given = false;     //!< --max-cells was on the command line (set by the parser)
-  int waypoints = 2;                //!< waypoints of the joint-linear path
-  bool waypoints_given = false;     //!< --waypoints was on the command line (set by the parser)
-  int threads = default_threads();  //!< worker threads
-  bool json = false;                //!< print the bounds file instead of text
-  bool no_plan = false;             //!< exit 1 on a colliding straight path instead of planning
-  PlanOptions plan;                 //!< planner seed and time limit
+  std::string cell;                  //!< MJCF file of the workcell
+  std::string checker = "midphase";  //!< --checker
+  std::string from, to;              //!< path ends: keyframe, site:NAME or xyz:X,Y,Z
+  std::string path;                  //!< a path file instead of from/to
+  std::string ik_seed;               //!< keyframe seeding the IK of gripper goals
+  std::string params;                //!< parameter file (JSON)
+  std::string preset = "leeway";     //!< parameter set
+  std::string safety;                //!< safety mode; empty: the preset's
+  std::string out;                   //!< bounds file to write (JSON); empty: none
+  int max_cells = 0;                 //!< MAX_cells, used when max_cells_given
+  bool max_cells_given = false;      //!< --max-cells was on the command line (set by the parser)
+  int waypoints = 2;                 //!< waypoints of the joint-linear path
+  bool waypoints_given = false;      //!< --waypoints was on the command line (set by the parser)
+  int threads = default_threads();   //!< worker threads
+  bool json = false;                 //!< print the bounds file instead of text
+  bool no_plan = false;              //!< exit 1 on a colliding straight path instead of planning
+  PlanOptions plan;                  //!< planner seed and time limit
 };
 
 //! Adds the `bounds` subcommand, parsing into `args`; returns it.

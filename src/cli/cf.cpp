@@ -11,6 +11,7 @@ CLI::App* add_cf(CLI::App& app, CfArgs& args) {
   CLI::App* sub =
       app.add_subcommand("cf", "Confidence Factor of a bounds file against the real obstacles (section 4.1)");
   sub->add_option("cell", args.cell, "MJCF file of the workcell")->required();
+  add_checker_option(sub, args.checker);
   sub->add_option("bounds", args.bounds, "Bounds file written by leeway bounds --out")->required();
   sub->add_option("--windows", args.params.windows, "Windows along the path")->capture_default_str();
   sub->add_option("--samples", args.params.samples, "Random configurations per window")
@@ -22,7 +23,7 @@ CLI::App* add_cf(CLI::App& app, CfArgs& args) {
 }
 
 int run_cf(const CfArgs& args) {
-  const auto scene = Scene::load(args.cell, scene_options(kDefaultTool));
+  const auto scene = Scene::load(args.cell, scene_options(kDefaultTool, args.checker));
   if (args.threads < 1) throw InputError("--threads " + std::to_string(args.threads) + " must be >= 1");
   const auto wb = read_bounds(args.bounds, scene);
   const auto r = confidence_factor(scene, wb, args.params, args.threads);

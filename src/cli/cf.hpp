@@ -11,11 +11,12 @@ namespace leeway::cli {
 
 //! The command line of `leeway cf`.
 struct CfArgs {
-  std::string cell;                 //!< MJCF file of the workcell
-  std::string bounds;               //!< bounds file written by leeway bounds --out
-  bool json = false;                //!< JSON instead of text
-  int threads = default_threads();  //!< worker threads
-  CfParams params;                  //!< windows, samples, seed
+  std::string cell;                  //!< MJCF file of the workcell
+  std::string checker = "midphase";  //!< --checker
+  std::string bounds;                //!< bounds file written by leeway bounds --out
+  bool json = false;                 //!< JSON instead of text
+  int threads = default_threads();   //!< worker threads
+  CfParams params;                   //!< windows, samples, seed
 };
 
 //! Adds the `cf` subcommand, parsing into `args`; returns it.

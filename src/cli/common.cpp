@@ -11,10 +11,18 @@
 
 namespace leeway::cli {
 
-SceneOptions scene_options(const std::string& tool) {
+SceneOptions scene_options(const std::string& tool, const std::string& checker) {
   SceneOptions o;
   o.tool_site = tool;
+  o.checker = parse_checker(checker);
   return o;
+}
+
+void add_checker_option(CLI::App* sub, std::string& checker) {
+  sub->add_option("--checker", checker,
+                  "Collision checker: midphase (leeway's, the default) or mujoco (MuJoCo's full\n"
+                  "mj_collision pass, the reference; same answers, slower)")
+      ->capture_default_str();
 }
 
 nlohmann::json to_array(const Eigen::VectorXd& v) { return detail::to_json_array(v); }

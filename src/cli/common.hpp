@@ -56,8 +56,12 @@ int run_reporting_errors(const char* program, Body&& body) {
   }
 }
 
-//! Scene options with the given tool site.
-SceneOptions scene_options(const std::string& tool);
+//! Scene options with the given tool site and collision checker ("midphase" or "mujoco").
+//! @throws InputError on an unknown checker.
+SceneOptions scene_options(const std::string& tool, const std::string& checker = "midphase");
+
+//! Adds --checker (the collision checker) to a subcommand.
+void add_checker_option(CLI::App* sub, std::string& checker);
 
 //! A vector as a JSON array.
 nlohmann::json to_array(const Eigen::VectorXd& v);

@@ -19,6 +19,7 @@ CLI::App* add_plan(CLI::App& app, PlanArgs& args) {
       "(also a start or goal in collision).");
   PlanOptions& o = args.options;
   sub->add_option("cell", args.cell, "MJCF file of the workcell")->required();
+  add_checker_option(sub, args.checker);
   sub->add_option("--from", args.from, "Start: a keyframe, site:NAME or xyz:X,Y,Z [m]")->required();
   sub->add_option("--to", args.to, "Goal: a keyframe, site:NAME or xyz:X,Y,Z [m]")->required();
   sub->add_option("--seed", o.seed, "Random seed (same seed, same path)")->capture_default_str();
@@ -41,7 +42,7 @@ CLI::App* add_plan(CLI::App& app, PlanArgs& args) {
 }
 
 int run_plan(const PlanArgs& args) {
-  const auto scene = Scene::load(args.cell, scene_options(args.tool));
+  const auto scene = Scene::load(args.cell, scene_options(args.tool, args.checker));
   PlanOptions options = args.options;
   options.simplify = !args.no_simplify;
   options.try_direct = !args.no_direct;

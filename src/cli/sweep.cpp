@@ -38,6 +38,7 @@ CLI::App* add_sweep(CLI::App& app, SweepArgs& args) {
   CLI::App* sub = app.add_subcommand(
       "sweep", "The thesis's table: for each MAX_cells, boxes, time [ms] and CF [%], as Markdown (and CSV)");
   sub->add_option("cell", args.cell, "MJCF file of the workcell")->required();
+  add_checker_option(sub, args.checker);
   sub->add_option("--from", args.from, "Keyframe the path starts at")->required();
   sub->add_option("--to", args.to, "Keyframe the path ends at")->required();
   sub->add_option("--waypoints", args.waypoints, "Waypoints along the joint-linear path")
@@ -60,7 +61,7 @@ CLI::App* add_sweep(CLI::App& app, SweepArgs& args) {
 }
 
 int run_sweep(const SweepArgs& args) {
-  const auto scene = Scene::load(args.cell, scene_options(kDefaultTool));
+  const auto scene = Scene::load(args.cell, scene_options(kDefaultTool, args.checker));
   const Params base = load_params(scene, args.preset, args.params, args.safety);
   // CF settings: the parameter file's cf section unless given on the command line.
   CfParams cf = args.cf;

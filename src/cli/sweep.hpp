@@ -16,6 +16,7 @@ extern const char* const kThesisCells;
 //! The command line of `leeway sweep`.
 struct SweepArgs {
   std::string cell;                      //!< MJCF file of the workcell
+  std::string checker = "midphase";      //!< --checker
   std::string from, to;                  //!< keyframes the path starts and ends at
   int waypoints = 2;                     //!< waypoints of the joint-linear path
   std::string max_cells = kThesisCells;  //!< comma-separated MAX_cells values

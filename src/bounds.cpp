@@ -1,7 +1,9 @@
 #include "leeway/bounds.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -118,8 +120,14 @@ std::vector<BoundKind> bound_kinds(const Scene& scene) {
   return kinds;
 }
 
-WaypointBounds bound_waypoint(const Scene& scene, const CollisionFn& collides, const Eigen::VectorXd& q,
-                              const BoundsParams& params) {
+namespace {
+
+// Runs `count` independent Algorithm-2 runs: run(k, collides) for k in [0, count), in any order and
+// on any thread; each run writes only its own result.
+using RunAll = std::function<void(int count, const std::function<void(int, const CollisionFn&)>& run)>;
+
+WaypointBounds bound_waypoint_runs(const Scene& scene, const CollisionFn& collides, const RunAll& run_all,
+                                   const Eigen::VectorXd& q, const BoundsParams& params) {
   scene.validate_configuration(q, "waypoint");
   const int n = scene.dof();
   const Eigen::VectorXd lo = scene.lower_limits(), hi = scene.upper_limits();
@@ -152,13 +160,28 @@ WaypointBounds bound_waypoint(const Scene& scene, const CollisionFn& collides, c
   w.nominal_in_volume = collides(q);
 
   // Algorithm 3: j1 at nominal; j2 with j1 at each of its bounds; j3 with every combination of
-  // j1's and j2's bounds. The most restrictive result is kept (highest lower, lowest upper).
+  // j1's and j2's bounds. The most restrictive result is kept (highest lower, lowest upper). The
+  // runs of one joint (2, then 4, then 8) are independent: run_all may spread them over threads;
+  // their results are combined in a fixed order, so the bounds do not depend on how.
   std::vector<Eigen::VectorXd> bases = {q};
   for (int j : bisected) {
+    const int runs = 2 * static_cast<int>(bases.size());
+    std::vector<double> value(static_cast<size_t>(runs));
+    std::vector<long> checks(static_cast<size_t>(runs), 0);
+    run_all(runs, [&](int k, const CollisionFn& c) {
+      const Eigen::VectorXd& base = bases[static_cast<size_t>(k / 2)];
+      const size_t at = static_cast<size_t>(k);
+      value[at] = k % 2 == 0 ? bound_lower(c, base, j, lo[j], params.resolution, checks[at])
+                             : bound_upper(c, base, j, hi[j], params.resolution, checks[at]);
+    });
     double lower = lo[j], upper = hi[j];
-    for (const Eigen::VectorXd& base : bases) {
-      lower = std::max(lower, bound_lower(collides, base, j, lo[j], params.resolution, w.checks));
-      upper = std::min(upper, bound_upper(collides, base, j, hi[j], params.resolution, w.checks));
+    for (int k = 0; k < runs; ++k) {
+      const size_t at = static_cast<size_t>(k);
+      if (k % 2 == 0)
+        lower = std::max(lower, value[at]);
+      else
+        upper = std::min(upper, value[at]);
+      w.checks += checks[at];
     }
     // Collapse guard (section 3.3): an interval shrunk to the nominal value gets a small one.
     if (upper - lower < params.resolution) {
@@ -182,18 +205,52 @@ WaypointBounds bound_waypoint(const Scene& scene, const CollisionFn& collides, c
   return w;
 }
 
+}  // namespace
+
+WaypointBounds bound_waypoint(const Scene& scene, const CollisionFn& collides, const Eigen::VectorXd& q,
+                              const BoundsParams& params) {
+  const RunAll in_order = [&collides](int count, const std::function<void(int, const CollisionFn&)>& run) {
+    for (int k = 0; k < count; ++k) run(k, collides);
+  };
+  return bound_waypoint_runs(scene, collides, in_order, q, params);
+}
+
 std::vector<WaypointBounds> bound_path(const VolumeModel& world, const std::vector<Eigen::VectorXd>& path,
                                        const BoundsParams& params, int threads) {
   const Scene& scene = world.scene();
   std::vector<WaypointBounds> out(path.size());
-  detail::parallel_for(static_cast<int>(path.size()), threads, [&] {
-    // One VolumeChecker (one mjData) per thread.
-    auto checker = std::make_shared<VolumeChecker>(world);
-    return [&, checker](int i) {
-      const CollisionFn collides = [&checker](const Eigen::VectorXd& q) { return checker->in_collision(q); };
-      out[static_cast<size_t>(i)] = bound_waypoint(scene, collides, path[static_cast<size_t>(i)], params);
-    };
-  });
+  const int waypoints = static_cast<int>(path.size());
+  threads = std::max(1, threads);
+  // One VolumeChecker (one mjData) per thread, made once.
+  std::vector<std::unique_ptr<VolumeChecker>> checkers;
+  for (int t = 0; t < threads; ++t) checkers.push_back(std::make_unique<VolumeChecker>(world));
+  auto collides_with = [](VolumeChecker& c) {
+    return CollisionFn([&c](const Eigen::VectorXd& q) { return c.in_collision(q); });
+  };
+  if (waypoints >= threads) {
+    // Enough waypoints for every thread: one waypoint per task, its runs in order.
+    std::atomic<int> slot{0};
+    detail::parallel_for(waypoints, threads, [&] {
+      VolumeChecker& checker = *checkers[static_cast<size_t>(slot++)];
+      return [&](int i) {
+        out[static_cast<size_t>(i)] =
+            bound_waypoint(scene, collides_with(checker), path[static_cast<size_t>(i)], params);
+      };
+    });
+    return out;
+  }
+  // Fewer waypoints than threads (the thesis's paths have two): waypoint after waypoint, the runs of
+  // each joint level spread over the threads.
+  const RunAll spread = [&](int count, const std::function<void(int, const CollisionFn&)>& run) {
+    std::atomic<int> slot{0};
+    detail::parallel_for(count, threads, [&] {
+      const CollisionFn c = collides_with(*checkers[static_cast<size_t>(slot++)]);
+      return [&run, c](int k) { run(k, c); };
+    });
+  };
+  for (int i = 0; i < waypoints; ++i)
+    out[static_cast<size_t>(i)] =
+        bound_waypoint_runs(scene, collides_with(*checkers[0]), spread, path[static_cast<size_t>(i)], params);
   return out;
 }
 

@@ -113,6 +113,8 @@ std::vector<GoldenCase> golden_cases() {
   c.push_back({"error_plan_unknown_key", "plan " + dallara + " --from home --to nowhere"});
   c.push_back({"error_params_preset", "params --preset nope"});
   c.push_back({"error_bounds_safety", "bounds " + dallara + " --from home --to patch --safety nope"});
+  c.push_back({"error_bounds_checker", "bounds " + dallara + " --from home --to patch --checker fcl"});
+  c.push_back({"error_cf_checker", "cf " + dallara + " nothing.json --checker MuJoCo"});
   return c;
 }
 

@@ -10,6 +10,7 @@
 #include <random>
 #include <set>
 
+#include "leeway/bounds.hpp"
 #include "leeway/box.hpp"
 #include "leeway/categorize.hpp"
 #include "leeway/error.hpp"
@@ -267,6 +268,33 @@ TEST_F(CollisionTest, BoxesPlacedAtALinksBottomCornerAgree) {
       ++agreed;
     }
   EXPECT_EQ(agreed, 15);
+}
+
+TEST_F(CollisionTest, BoundsAreIdenticalForOneTwoAndFourThreads) {
+  // Two waypoints (fewer than the threads: the runs of each joint level are spread) and five (one
+  // waypoint per task), on the Dallara cell with the thesis's parameters.
+  const Scene scene = Scene::load(test::workcell("dallara"));
+  Params params = preset_params("thesis");
+  params.height_map.max_cells = 5000;
+  for (int waypoints : {2, 5}) {
+    const auto path = keyframe_path(scene, "home", "patch", waypoints);
+    const Categories c = categorize(scene, path, params.categorize);
+    VolumeModel world(scene, 16);
+    world.set_boxes(generate_volume(c, params.height_map, params.volume).boxes);
+    const auto one = bound_path(world, path, params.bounds, 1);
+    for (int threads : {2, 4}) {
+      const auto many = bound_path(world, path, params.bounds, threads);
+      ASSERT_EQ(many.size(), one.size());
+      for (size_t i = 0; i < one.size(); ++i) {
+        EXPECT_EQ(many[i].lower, one[i].lower) << waypoints << " waypoints, " << threads << " threads";
+        EXPECT_EQ(many[i].upper, one[i].upper) << waypoints << " waypoints, " << threads << " threads";
+        EXPECT_EQ(many[i].collapsed, one[i].collapsed);
+        EXPECT_EQ(many[i].checks, one[i].checks);
+        EXPECT_EQ(many[i].nominal_in_volume, one[i].nominal_in_volume);
+      }
+    }
+    EXPECT_GT(one[0].checks, 14);  // all 14 runs ran
+  }
 }
 
 }  // namespace

@@ -84,7 +84,10 @@ void require_joint_counts(const Scene& scene, const std::vector<WaypointBounds>&
 std::vector<BoundKind> bound_kinds(const Scene& scene);
 
 //! Bounds of every waypoint against the volume in `world`, spread over `threads` threads (one
-//! VolumeChecker each). Deterministic: the result does not depend on the thread count.
+//! VolumeChecker each): one waypoint per task when there are at least as many waypoints as threads,
+//! otherwise waypoint after waypoint with the 2, 4 and 8 Algorithm-2 runs of each joint level of
+//! Algorithm 3 spread over the threads. Deterministic: the result, checks included, does not depend
+//! on the thread count.
 std::vector<WaypointBounds> bound_path(const VolumeModel& world, const std::vector<Eigen::VectorXd>& path,
                                        const BoundsParams& params, int threads);
 

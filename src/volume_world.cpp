@@ -264,8 +264,13 @@ void VolumeModel::set_boxes(const std::vector<Box>& boxes) {
     const int g = first_pool_geom_ + i;
     if (i < n) {
       const Box& b = boxes[static_cast<size_t>(i)];
-      Eigen::Matrix<double, 3, 3, Eigen::RowMajor> r = b.rotation;
-      mju_mat2Quat(m.geom_quat + 4 * g, r.data());
+      if (b.rotation == Eigen::Matrix3d::Identity()) {  // the height map's boxes: what mju gives
+        const mjtNum unit[4] = {1, 0, 0, 0};
+        std::memcpy(m.geom_quat + 4 * g, unit, sizeof(unit));
+      } else {
+        Eigen::Matrix<double, 3, 3, Eigen::RowMajor> r = b.rotation;
+        mju_mat2Quat(m.geom_quat + 4 * g, r.data());
+      }
       for (int k = 0; k < 3; ++k) {
         m.geom_pos[3 * g + k] = b.center[k];
         m.geom_size[3 * g + k] = b.half_size[k];
@@ -340,8 +345,22 @@ bool VolumeChecker::midphase_collision() {
     Aabb q = geom_aabb(m, d, g);
     q.lo.array() -= m.geom_margin[g];
     q.hi.array() += m.geom_margin[g];
+    // The link box's own face axes separate most candidates (a long link's AABB holds many cells
+    // its oriented box does not reach): a gap of more than 1e-9 m along one of them means no
+    // contact for the narrowphase either, so those pairs skip it.
+    const bool is_box = m.geom_type[g] == mjGEOM_BOX && m.geom_margin[g] == 0;
+    const Eigen::Map<const Eigen::Matrix<mjtNum, 3, 3, Eigen::RowMajor>> axes(d.geom_xmat + 9 * g);
+    const Eigen::Map<const Eigen::Vector3d> centre(d.geom_xpos + 3 * g), half(m.geom_size + 3 * g);
     const bool hit = boxes.grid.any(q, [&](int i) {
       const int p = boxes.geoms[static_cast<size_t>(i)];
+      if (is_box && pool.geom_margin[p] == 0) {
+        const Eigen::Map<const Eigen::Matrix<mjtNum, 3, 3, Eigen::RowMajor>> b(world_->pool_xmat(i));
+        const Eigen::Map<const Eigen::Vector3d> bc(world_->pool_xpos(i)), bh(pool.geom_size + 3 * p);
+        // Columns of `axes` are the link's axes; of `b`, the box's. Projections on the link's axes.
+        const Eigen::Vector3d offset = (axes.transpose() * (bc - centre)).cwiseAbs();
+        const Eigen::Vector3d reach = half + (axes.transpose() * b).cwiseAbs() * bh;
+        if (((offset - reach).array() > 1e-9).any()) return false;
+      }
       std::memcpy(m.geom_size + 3 * slot, pool.geom_size + 3 * p, 3 * sizeof(mjtNum));
       m.geom_rbound[slot] = pool.geom_rbound[p];
       m.geom_contype[slot] = pool.geom_contype[p];

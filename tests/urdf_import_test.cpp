@@ -479,5 +479,44 @@ TEST(UrdfImportCliTest, SevenJointArmEndToEnd) {
             1.0);  // certified bounds: no sample collides
 }
 
+TEST(UrdfImportCliTest, FourJointArmPlansAndBounds) {
+  // arm7.urdf with a5, a6 and a7 fixed: four joints, three of them the bisected hinges.
+  test::TempDir dir;
+  std::ifstream in(kArm7Urdf);
+  std::string urdf((std::istreambuf_iterator<char>(in)), {});
+  for (const char* j : {"a5", "a6", "a7"})
+    urdf = edited(urdf, std::string("name=\"") + j + "\" type=\"revolute\"",
+                  std::string("name=\"") + j + "\" type=\"fixed\"");
+  const std::string source = dir.write("arm4.urdf", urdf);
+  const fs::path robot = dir.path() / "arm4.xml", cell = dir.path() / "cell.xml",
+                 path = dir.path() / "p.json", bounds = dir.path() / "b.json";
+  const auto imp = test::run_cli("import-urdf " + source + " --out " + quoted(robot));
+  ASSERT_EQ(imp.exit_code, 0) << imp.out;
+  EXPECT_THAT(imp.out, HasSubstr("4 joints (a1, a2, a3, a4)"));
+  ASSERT_EQ(test::run_cli("new-cell --robot " + quoted(robot) + " --out " + quoted(cell)).exit_code, 0);
+  std::ifstream cin(cell);
+  std::string xml((std::istreambuf_iterator<char>(cin)), {});
+  xml = edited(xml, "  </worldbody>",
+               "    <geom name=\"table\" type=\"box\" pos=\"0.8 0 0.25\" size=\"0.3 0.4 0.25\" contype=\"0\" "
+               "conaffinity=\"1\"/>\n  </worldbody>");
+  xml = edited(xml, "  </keyframe>", "    <key name=\"over\" qpos=\"0.3 0.6 0 1.2\"/>\n  </keyframe>");
+  std::ofstream(cell) << xml;
+  const auto check = test::run_cli("check " + quoted(cell));
+  ASSERT_EQ(check.exit_code, 0) << check.out;
+  const auto ik = test::run_cli("ik " + quoted(cell) + " --xyz 0.8 0.2 0.65 --free-orientation --json");
+  ASSERT_EQ(ik.exit_code, 0) << ik.out;
+  const auto plan = test::run_cli("plan " + quoted(cell) + " --from home --to over --out " + quoted(path));
+  ASSERT_EQ(plan.exit_code, 0) << plan.out;
+  const auto b = test::run_cli("bounds " + quoted(cell) + " --path " + quoted(path) + " --threads 1 --out " +
+                               quoted(bounds));
+  ASSERT_EQ(b.exit_code, 0) << b.out;
+  EXPECT_EQ(test::read_json(bounds).at("joint_bounding"),
+            nlohmann::json({"bisected", "bisected", "bisected", "fixed"}));
+  const auto cf =
+      test::run_cli("cf " + quoted(cell) + " " + quoted(bounds) + " --samples 2000 --threads 1 --json");
+  ASSERT_EQ(cf.exit_code, 0) << cf.out;
+  EXPECT_EQ(nlohmann::json::parse(cf.out).at("cf").get<double>(), 1.0);
+}
+
 }  // namespace
 }  // namespace leeway

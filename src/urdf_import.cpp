@@ -276,8 +276,14 @@ class Importer {
       throw UrdfOptionError(file_ + ": no tool link: the URDF has no link '" + options_.tool_link +
                                 "' (the flange frame, 'tool0' in ROS-Industrial); links: " + link_names(),
                             "tool_link");
-    for (auto l = tool; l; l = l->getParent())
+    size_t steps = 0;
+    for (auto l = tool; l; l = l->getParent()) {
       if (l == base) return tool;
+      // A cycle of links each with one parent joint, apart from the root's tree, has no end.
+      if (++steps > model_->links_.size())
+        throw InputError(file_ + ": link '" + l->name + "' lies on a joint loop above the tool link '" +
+                         tool->name + "' (a URDF must be a tree)");
+    }
     throw UrdfOptionError(
         file_ + ": tool link '" + tool->name + "' is not below the base link '" + base->name + "'",
         "tool_link");

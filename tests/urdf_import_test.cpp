@@ -339,6 +339,14 @@ TEST(UrdfImportCliTest, BadUrdfsExitTwoWithOneMessageAndNoFile) {
            R"(<joint name="back" type="fixed"><parent link="link_2"/><child link="link_1"/></joint></robot>)"),
        "",
        {"link 'link_1' is the child of joints 'back', 'j1'", "joint loop"}},
+      {"cycle",
+       edited(
+           kTwoJoints, "</robot>",
+           R"(<link name="ring_a"/><link name="ring_b"><collision><geometry><sphere radius="1"/></geometry>)"
+           R"(</collision></link><joint name="r1" type="fixed"><parent link="ring_a"/><child link="ring_b"/></joint>)"
+           R"(<joint name="r2" type="fixed"><parent link="ring_b"/><child link="ring_a"/></joint></robot>)"),
+       "--tool ring_b",
+       {"joint loop above the tool link 'ring_b'"}},
       {"missing",
        edited(kTwoJoints, box2, R"(<mesh filename="meshes/absent.stl"/>)"),
        "",

@@ -214,6 +214,26 @@ TEST_F(UrdfImportTest, MeshPathsFileUriRelativeAndScaledRotated) {
   EXPECT_LT((world_half(uri) - Eigen::Vector3d(0.5, 0.25, 0.75)).norm(), 1e-12);
 }
 
+TEST_F(UrdfImportTest, FlatMeshesAreThickenedWithANote) {
+  test::TempDir dir;
+  test::write_binary_stl((dir.path() / "plate.stl").string(),
+                         {{Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0)}});
+  const std::string urdf = dir.write("plate.urdf", R"(<robot name="plate">
+  <link name="base_link"/>
+  <link name="link_1"><collision><geometry><mesh filename="plate.stl"/></geometry></collision></link>
+  <link name="tool0"/>
+  <joint name="j1" type="revolute"><parent link="base_link"/><child link="link_1"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <joint name="t" type="fixed"><parent link="link_1"/><child link="tool0"/></joint>
+</robot>)");
+  const UrdfImport robot = import_urdf(urdf);
+  ASSERT_EQ(robot.notes.size(), 1u);
+  EXPECT_THAT(robot.notes[0],
+              AllOf(HasSubstr("link 'link_1' <collision> 1"), HasSubstr("half-size 0 m along box axis z"),
+                    HasSubstr("thickened to 0.0005 m")));
+  EXPECT_THAT(robot.mjcf, HasSubstr("pos=\"0.5 0.5 0\" size=\"0.5 0.5 0.0005\""));
+}
+
 TEST_F(UrdfImportTest, OffChainJointsAreFrozenAndNoted) {
   test::TempDir dir;
   const std::string urdf = dir.write("finger.urdf", R"(<robot name="finger">

@@ -15,6 +15,8 @@
 #include "cli/common.hpp"
 #include "cli/fk.hpp"
 #include "cli/ik.hpp"
+#include "cli/import_urdf.hpp"
+#include "cli/new_cell.hpp"
 #include "cli/params.hpp"
 #include "cli/plan.hpp"
 #include "cli/sweep.hpp"
@@ -37,6 +39,8 @@ int main(int argc, char** argv) {
   CfArgs cf;
   SweepArgs sweep;
   ParamsArgs params;
+  ImportUrdfArgs import_urdf;
+  NewCellArgs new_cell;
   // In the order of `leeway --help`.
   const std::vector<std::pair<CLI::App*, std::function<int()>>> commands = {
       {add_check(app, check), [&] { return run_check(check); }},
@@ -47,6 +51,8 @@ int main(int argc, char** argv) {
       {add_cf(app, cf), [&] { return run_cf(cf); }},
       {add_sweep(app, sweep), [&] { return run_sweep(sweep); }},
       {add_params(app, params), [&] { return run_params(params); }},
+      {add_import_urdf(app, import_urdf), [&] { return run_import_urdf(import_urdf); }},
+      {add_new_cell(app, new_cell), [&] { return run_new_cell(new_cell); }},
   };
 
   return run_reporting_errors("leeway", [&]() -> int {

@@ -92,6 +92,10 @@ std::vector<GoldenCase> golden_cases() {
   c.push_back({"version", "--version"});
   for (const std::string sub : {"check", "fk", "ik", "plan", "bounds", "cf", "sweep", "params"})
     c.push_back({"help_" + sub, sub + " --help"});
+  c.push_back({"help_import_urdf", "import-urdf --help"});
+  c.push_back({"help_new_cell", "new-cell --help"});
+  c.push_back(
+      {"error_import_urdf_no_tool", "import-urdf tests/data/urdf/arm7.urdf --tool hand --out arm7.xml"});
   // Errors.
   c.push_back({"error_no_subcommand", ""});
   c.push_back({"error_unknown_subcommand", "frobnicate " + dallara});

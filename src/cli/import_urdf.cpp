@@ -1,0 +1,57 @@
+#include "cli/import_urdf.hpp"
+
+#include <cstdlib>
+#include <iostream>
+
+#include "leeway/error.hpp"
+#include "leeway/pipeline.hpp"
+#include "leeway/urdf_import.hpp"
+
+namespace leeway::cli {
+
+CLI::App* add_import_urdf(CLI::App& app, ImportUrdfArgs& args) {
+  CLI::App* sub = app.add_subcommand(
+      "import-urdf",
+      "Import a URDF robot as an MJCF robot fragment in leeway's conventions (docs/robots.md)");
+  sub->add_option("urdf", args.urdf, "The URDF file (run xacro first for .xacro files)")->required();
+  sub->add_option("--out", args.out, "The MJCF fragment to write, e.g. mjcf/robots/NAME.xml")->required();
+  sub->add_option("--package-path", args.package_paths,
+                  "A folder holding ROS packages, for package:// URIs (repeatable; searched before\n"
+                  "ROS_PACKAGE_PATH)");
+  sub->add_option("--tool", args.tool, "The tool (flange) link: its frame becomes the site tool0")
+      ->capture_default_str();
+  sub->add_option("--base-link", args.base_link,
+                  "The robot's fixed base link (default: the URDF's root link)");
+  sub->add_flag("--continuous-full-turn", args.continuous_full_turn,
+                "Import continuous joints with the range -2 pi .. 2 pi rad (default: refuse them)");
+  return sub;
+}
+
+int run_import_urdf(const ImportUrdfArgs& args) {
+  UrdfImportOptions options;
+  options.package_paths = args.package_paths;
+  if (const char* env = std::getenv("ROS_PACKAGE_PATH")) options.ros_package_path = env;
+  options.tool_link = args.tool;
+  options.base_link = args.base_link;
+  options.continuous_full_turn = args.continuous_full_turn;
+  UrdfImport robot;
+  try {
+    robot = import_urdf(args.urdf, options);
+  } catch (const UrdfOptionError& e) {
+    // The library names the data; name the option that changes it.
+    const std::string& f = e.field();
+    const std::string flag = f == "continuous_full_turn" ? "--continuous-full-turn"
+                             : f == "tool_link"          ? "--tool LINK"
+                                                         : "--base-link LINK";
+    throw InputError(std::string(e.what()) + " (see " + flag + ")");
+  }
+  write_file_atomic(args.out, robot.mjcf);
+  std::cout << "wrote " << args.out << ": robot '" << robot.robot_name << "', " << robot.joints.size()
+            << " joints (";
+  for (size_t i = 0; i < robot.joints.size(); ++i) std::cout << (i ? ", " : "") << robot.joints[i];
+  std::cout << "), " << robot.boxes << " collision boxes\n";
+  for (const auto& n : robot.notes) std::cout << "note: " << n << "\n";
+  return kExitOk;
+}
+
+}  // namespace leeway::cli

@@ -10,7 +10,7 @@
 
 #include "leeway/check.hpp"
 #include "leeway/error.hpp"
-#include "leeway/pipeline.hpp"
+#include "leeway/file_io.hpp"
 #include "leeway/scene.hpp"
 #include "mjcf_text.hpp"
 

@@ -4,7 +4,7 @@
 #include <iostream>
 
 #include "leeway/error.hpp"
-#include "leeway/pipeline.hpp"
+#include "leeway/file_io.hpp"
 #include "leeway/urdf_import.hpp"
 
 namespace leeway::cli {

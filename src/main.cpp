@@ -17,6 +17,8 @@
 #include "cli/ik.hpp"
 #include "cli/params.hpp"
 #include "cli/plan.hpp"
+#include "cli/plot.hpp"
+#include "cli/render.hpp"
 #include "cli/sweep.hpp"
 #include "leeway/error.hpp"
 #include "leeway/mujoco_util.hpp"
@@ -37,6 +39,8 @@ int main(int argc, char** argv) {
   CfArgs cf;
   SweepArgs sweep;
   ParamsArgs params;
+  RenderArgs render;
+  PlotArgs plot;
   // In the order of `leeway --help`.
   const std::vector<std::pair<CLI::App*, std::function<int()>>> commands = {
       {add_check(app, check), [&] { return run_check(check); }},
@@ -47,6 +51,8 @@ int main(int argc, char** argv) {
       {add_cf(app, cf), [&] { return run_cf(cf); }},
       {add_sweep(app, sweep), [&] { return run_sweep(sweep); }},
       {add_params(app, params), [&] { return run_params(params); }},
+      {add_render(app, render), [&] { return run_render(render); }},
+      {add_plot(app, plot), [&] { return run_plot(plot); }},
   };
 
   return run_reporting_errors("leeway", [&]() -> int {

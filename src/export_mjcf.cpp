@@ -1,10 +1,14 @@
 #include "leeway/export_mjcf.hpp"
 
+#include <unistd.h>
+
 #include <cctype>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <regex>
 #include <sstream>
@@ -223,9 +227,20 @@ std::string volume_mjb(const std::string& cell_path, const std::vector<Box>& box
   mj_deleteVFS(vfs.get());
   if (!m) throw InputError(cell_path + ": does not compile with the volume added: " + std::string(error));
   take_mujoco_warnings();
-  const int size = mj_sizeModel(m.get());
-  std::string bytes(static_cast<size_t>(size), '\0');
-  mj_saveModel(m.get(), nullptr, bytes.data(), size);
+  // mj_sizeModel counts the in-memory alignment padding that mj_saveModel does not write (a loader
+  // then warns "Model file is too large"), so save to a scratch file and take its bytes.
+  const fs::path scratch =
+      fs::temp_directory_path() / ("leeway-export-" + std::to_string(::getpid()) + "-" +
+                                   std::to_string(reinterpret_cast<std::uintptr_t>(m.get())) + ".mjb");
+  mj_saveModel(m.get(), scratch.c_str(), nullptr, 0);
+  std::string bytes;
+  {
+    std::ifstream in(scratch, std::ios::binary);
+    if (!in) throw std::runtime_error("MuJoCo did not save the model to " + scratch.string());
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  std::error_code ec;
+  fs::remove(scratch, ec);
   return bytes;
 }
 

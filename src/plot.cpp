@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -454,6 +456,52 @@ Image bounds_image(const BoundsSeries& series, int width, int height) {
 
 // ---------------------------------------------------------------------------------------------
 // Sweep plots.
+
+SweepSeries read_sweep_csv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open the sweep CSV file");
+  auto split = [](const std::string& line) {
+    std::vector<std::string> f;
+    std::stringstream fields(line);
+    for (std::string x; std::getline(fields, x, ',');) f.push_back(x);
+    return f;
+  };
+  std::string line;
+  if (!std::getline(in, line)) throw InputError(path + ": empty sweep CSV file");
+  const auto header = split(line);
+  std::vector<size_t> col;
+  for (const char* name : {"max_cells", "boxes", "time_ms", "cf"}) {
+    const auto it = std::find(header.begin(), header.end(), name);
+    if (it == header.end())
+      throw InputError(path + ": line 1 has no column '" + name + "' (a leeway sweep --csv file)");
+    col.push_back(static_cast<size_t>(it - header.begin()));
+  }
+  SweepSeries out{std::filesystem::path(path).stem().string(), {}};
+  for (int number = 2; std::getline(in, line); ++number) {
+    if (line.empty()) continue;
+    const auto f = split(line);
+    double v[4] = {};
+    for (size_t k = 0; k < 4; ++k) {
+      const std::string where =
+          path + ": line " + std::to_string(number) + " column '" + header[col[k]] + "'";
+      if (col[k] >= f.size()) throw InputError(where + " is missing");
+      try {
+        size_t used = 0;
+        v[k] = std::stod(f[col[k]], &used);
+        if (used != f[col[k]].size()) throw std::invalid_argument("trailing text");
+      } catch (const std::exception&) {
+        throw InputError(where + ": '" + f[col[k]] + "' is not a number");
+      }
+      if (!std::isfinite(v[k])) throw InputError(where + ": '" + f[col[k]] + "' is not a finite number");
+    }
+    if (v[0] < 1 || v[0] != std::floor(v[0]) || v[0] > kMaxCellsLimit)
+      throw InputError(path + ": line " + std::to_string(number) + ": max_cells " + format_number(v[0]) +
+                       " is not a whole number from 1 to 1000000");
+    out.points.push_back({static_cast<int>(v[0]), v[1], v[2], 100 * v[3]});
+  }
+  if (out.points.empty()) throw InputError(path + ": no rows");
+  return out;
+}
 
 std::vector<SweepPoint> thesis_table(const std::string& cell, const std::string& path, std::string* table) {
   std::vector<SweepPoint> out;

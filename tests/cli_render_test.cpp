@@ -252,6 +252,41 @@ TEST_F(CliRenderTest, SweepPlotHasTheThesisSeriesForOneOfTheNineCases) {
   EXPECT_THAT(r.out, HasSubstr("must end in .svg or .png"));
 }
 
+TEST_F(CliRenderTest, PlotOfSweepCsvFilesBesideTheThesisTable) {
+  const std::string a =
+      dir_.write("a.csv", "max_cells,boxes,time_ms,cf\n100,60,18.3,0.9\n1000,600,80,0.99\n");
+  const std::string b = dir_.write("b.csv", "max_cells,boxes,time_ms,cf,extra\n100,50,10,0.95,x\n");
+  auto r = run_cli("plot " + a + " " + b + " --thesis dlr/mould-home --out " + path("s.svg"));
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  // Three panels with three series each: a, b and table 4.9.
+  EXPECT_EQ(svg_counts(path("s.svg"), {".//s:g[@class='panel']", ".//s:polyline[@data-series='a']",
+                                       ".//s:polyline[@data-series='thesis, table 4.9 (i5-8250U)']"}),
+            "3 3 3\n");
+  // CF 0.9 and 0.99 are plotted as 90 and 99 %: padded by 5 % to [89.55, 99.45], ticks every 2 %.
+  r = run_cli("plot " + a + " --out " + path("a.svg"));
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const std::string svg = test::run_program("cat", path("a.svg")).out;
+  EXPECT_THAT(svg, HasSubstr(">90</text>"));
+  EXPECT_THAT(svg, HasSubstr(">98</text>"));
+  const std::string bad = dir_.write("bad.csv", "max_cells,boxes,cf\n100,60,0.9\n");
+  const std::string nan = dir_.write("nan.csv", "max_cells,boxes,time_ms,cf\n100,60,nan,0.9\n");
+  struct Case {
+    std::string args, message;
+  };
+  const std::vector<Case> cases = {
+      {bad + " --out " + path("t.svg"), "bad.csv: line 1 has no column 'time_ms'"},
+      {nan + " --out " + path("t.svg"), "nan.csv: line 2 column 'time_ms': 'nan' is not a finite number"},
+      {a + " --thesis dallara/home-mould --out " + path("t.svg"), "--thesis 'dallara/home-mould'"},
+      {a + " " + bounds_file() + " --out " + path("t.svg"), "not both"},
+  };
+  for (const auto& c : cases) {
+    r = run_cli("plot " + c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args << "\n" << r.out;
+    EXPECT_THAT(r.out, HasSubstr(c.message)) << c.args;
+    EXPECT_FALSE(fs::exists(path("t.svg")));
+  }
+}
+
 TEST_F(CliRenderTest, ExportedMjcfAndMjbCompileWithTheFilesBoxes) {
   fs::create_directories(dir_.path() / "elsewhere");
   const std::string xml = path("elsewhere/volume.xml"), mjb = path("volume.mjb");

@@ -56,6 +56,12 @@ struct SweepSeries {
   std::vector<SweepPoint> points;
 };
 
+//! Reads a sweep's CSV file as `leeway sweep --csv` writes it (columns max_cells, boxes, time_ms and
+//! cf as a fraction, among others), labelled with the file's name without its extension.
+//! @throws InputError naming the file, line and column when a column is missing or a value is not a
+//! finite number.
+SweepSeries read_sweep_csv(const std::string& path);
+
 //! The thesis's published rows (tables 4.1-4.9, docs/data/thesis_tables.csv) for a cell named
 //! "dallara", "baltico" or "dlr" and a path "home-patch", "patch-mould" or "mould-home"; empty for
 //! any other case. `table` receives the table's number ("4.1").

@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 #include <string>
+#include <vector>
 
 #include "cli/common.hpp"
 #include "leeway/plot.hpp"
@@ -11,9 +12,10 @@ namespace leeway::cli {
 
 //! The command line of `leeway plot`.
 struct PlotArgs {
-  std::string bounds;  //!< bounds file
-  std::string out;     //!< .svg or .png file to write
-  std::string size;    //!< "WIDTHxHEIGHT" [pixels]; empty: 1000 wide, 240 per row of panels
+  std::vector<std::string> inputs;  //!< one bounds file, or sweep CSV files
+  std::string out;                  //!< .svg or .png file to write
+  std::string size;                 //!< "WIDTHxHEIGHT" [pixels]; empty: a size for the kind of plot
+  std::string thesis;               //!< sweep plots: "CELL/PATH" of the thesis table to add
 };
 
 //! Adds the `plot` subcommand, parsing into `args`; returns it.

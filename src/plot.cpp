@@ -362,7 +362,8 @@ std::string bounds_svg(const BoundsSeries& series, int width, int height) {
              " font-weight=\"bold\"");
     const std::vector<double> xt = {0, 0.25, 0.5, 0.75, 1}, yt = nice_ticks(ylo, yhi, 4);
     axes(svg, a, xt, labels(xt), yt, labels(yt), x, y);
-    svg.text(a.x + a.w / 2, a.y + a.h + 30, "path parameter s (waypoint k / (n - 1))", "middle", 10);
+    svg.text(a.x + a.w / 2, a.y + a.h + 30,
+             "path parameter s = k / (n - 1) at waypoint k; lines join the waypoints", "middle", 10);
     // The band between the bounds.
     std::string d = "M";
     for (size_t w = 0; w < n; ++w) d += " " + fixed(x(series.s[w])) + "," + fixed(y(series.upper[w][i]));

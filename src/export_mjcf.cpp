@@ -215,17 +215,13 @@ std::string volume_mjb(const std::string& cell_path, const std::vector<Box>& box
                        const std::string& out_path) {
   install_mujoco_error_handlers();
   const std::string xml = volume_mjcf(cell_path, boxes, out_path);
-  // Compiled from a virtual file named beside the output, where its relative paths point from.
-  auto vfs = std::make_unique<mjVFS>();
-  mj_defaultVFS(vfs.get());
-  const std::string vname = out_path + ".leeway-export.xml";
-  if (mj_makeEmptyFileVFS(vfs.get(), vname.c_str(), static_cast<int>(xml.size())) != 0)
-    throw std::runtime_error("cannot allocate a MuJoCo VFS file");
-  std::memcpy(vfs->filedata[vfs->nfile - 1], xml.data(), xml.size());
-  char error[1024] = "";
-  ModelPtr m(mj_loadXML(vname.c_str(), vfs.get(), error, sizeof(error)));
-  mj_deleteVFS(vfs.get());
-  if (!m) throw InputError(cell_path + ": does not compile with the volume added: " + std::string(error));
+  // Compiled as a file beside the output, where its relative paths point from.
+  ModelPtr m;
+  try {
+    m = load_model_text(xml, out_path + ".leeway-export.xml");
+  } catch (const InputError& e) {
+    throw InputError(cell_path + ": does not compile with the volume added (" + e.what() + ")");
+  }
   take_mujoco_warnings();
   // mj_sizeModel counts the in-memory alignment padding that mj_saveModel does not write (a loader
   // then warns "Model file is too large"), so save to a scratch file and take its bytes.

@@ -168,21 +168,7 @@ std::vector<std::string> labels(const std::vector<double>& v) {
 // MuJoCo figures (PNG output).
 
 // An empty model: mjr_makeContext needs one for its offscreen buffer size and fonts.
-ModelPtr empty_model() {
-  install_mujoco_error_handlers();
-  auto vfs = std::make_unique<mjVFS>();
-  mj_defaultVFS(vfs.get());
-  const std::string xml = "<mujoco model=\"leeway_plot\"/>";
-  const char* name = "leeway_plot.xml";
-  if (mj_makeEmptyFileVFS(vfs.get(), name, static_cast<int>(xml.size())) != 0)
-    throw std::runtime_error("cannot allocate a MuJoCo VFS file");
-  std::memcpy(vfs->filedata[vfs->nfile - 1], xml.data(), xml.size());
-  char error[512] = "";
-  mjModel* m = mj_loadXML(name, vfs.get(), error, sizeof(error));
-  mj_deleteVFS(vfs.get());
-  if (!m) throw std::runtime_error(std::string("MuJoCo rejected the empty plot model: ") + error);
-  return ModelPtr(m);
-}
+ModelPtr empty_model() { return load_model_text("<mujoco model=\"leeway_plot\"/>", "leeway_plot.xml"); }
 
 std::unique_ptr<mjvFigure> new_figure(const std::string& title, const std::string& xlabel) {
   auto fig = std::make_unique<mjvFigure>();

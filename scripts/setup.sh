@@ -2,12 +2,15 @@
 # Installs, from Debian's packages, whatever leeway needs to build and test that is not there yet.
 # Idempotent and non-interactive; when everything is installed it only asks dpkg and returns.
 # libqhull-dev: Debian's mujoco::mujoco target names /usr/include/libqhull_r as an include path.
+# libosmesa6-dev: offscreen OpenGL without a display for `leeway render` and PNG plots (MuJoCo links
+# no GL itself); zlib1g-dev: PNG compression.
 set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config clang-format python3
   libmujoco-dev libqhull-dev libeigen3-dev libompl-dev libnlopt-cxx-dev liburdfdom-dev
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
+  libosmesa6-dev zlib1g-dev
 )
 
 missing=()

@@ -19,6 +19,8 @@
 #include "cli/new_cell.hpp"
 #include "cli/params.hpp"
 #include "cli/plan.hpp"
+#include "cli/plot.hpp"
+#include "cli/render.hpp"
 #include "cli/sweep.hpp"
 #include "leeway/error.hpp"
 #include "leeway/mujoco_util.hpp"
@@ -41,6 +43,8 @@ int main(int argc, char** argv) {
   ParamsArgs params;
   ImportUrdfArgs import_urdf;
   NewCellArgs new_cell;
+  RenderArgs render;
+  PlotArgs plot;
   // In the order of `leeway --help`.
   const std::vector<std::pair<CLI::App*, std::function<int()>>> commands = {
       {add_check(app, check), [&] { return run_check(check); }},
@@ -53,6 +57,8 @@ int main(int argc, char** argv) {
       {add_params(app, params), [&] { return run_params(params); }},
       {add_import_urdf(app, import_urdf), [&] { return run_import_urdf(import_urdf); }},
       {add_new_cell(app, new_cell), [&] { return run_new_cell(new_cell); }},
+      {add_render(app, render), [&] { return run_render(render); }},
+      {add_plot(app, plot), [&] { return run_plot(plot); }},
   };
 
   return run_reporting_errors("leeway", [&]() -> int {

@@ -1,7 +1,10 @@
 #include "leeway/mujoco_util.hpp"
 
+#include <cstring>
 #include <fstream>
+#include <memory>
 #include <mutex>
+#include <stdexcept>
 
 #include "leeway/error.hpp"
 
@@ -34,6 +37,23 @@ std::vector<std::string> take_mujoco_warnings() {
   return out;
 }
 
+namespace {
+
+// MuJoCo's compiler error on one line: its message spans several ("...\nElement 'key', line 19").
+std::string one_line(const char* error) {
+  std::string msg;
+  for (const char* c = error; *c; ++c) {
+    if (*c == '\n') {
+      if (c[1] != '\0') msg += "; ";
+    } else {
+      msg += *c;
+    }
+  }
+  return msg;
+}
+
+}  // namespace
+
 ModelPtr load_model_file(const std::string& path) {
   // Documented in the header: without it a malformed file would make MuJoCo exit() the process.
   install_mujoco_error_handlers();
@@ -48,19 +68,22 @@ ModelPtr load_model_file(const std::string& path) {
     if (!m) throw InputError(path + ": not a valid MJB file for MuJoCo " + mj_versionString());
   } else {
     m = mj_loadXML(path.c_str(), nullptr, error, sizeof(error));
-    if (!m) {
-      // One line: MuJoCo's message spans several ("...\nElement 'key', line 19").
-      std::string msg;
-      for (const char* c = error; *c; ++c) {
-        if (*c == '\n') {
-          if (c[1] != '\0') msg += "; ";
-        } else {
-          msg += *c;
-        }
-      }
-      throw InputError(path + ": MJCF does not compile: " + msg);
-    }
+    if (!m) throw InputError(path + ": MJCF does not compile: " + one_line(error));
   }
+  return ModelPtr(m);
+}
+
+ModelPtr load_model_text(const std::string& xml, const std::string& virtual_path) {
+  install_mujoco_error_handlers();
+  auto vfs = std::make_unique<mjVFS>();
+  mj_defaultVFS(vfs.get());
+  if (mj_makeEmptyFileVFS(vfs.get(), virtual_path.c_str(), static_cast<int>(xml.size())) != 0)
+    throw std::runtime_error("cannot allocate a MuJoCo virtual file for " + virtual_path);
+  std::memcpy(vfs->filedata[vfs->nfile - 1], xml.data(), xml.size());
+  char error[1024] = "";
+  mjModel* m = mj_loadXML(virtual_path.c_str(), vfs.get(), error, sizeof(error));
+  mj_deleteVFS(vfs.get());
+  if (!m) throw InputError(virtual_path + ": MJCF does not compile: " + one_line(error));
   return ModelPtr(m);
 }
 

@@ -90,7 +90,8 @@ std::vector<GoldenCase> golden_cases() {
                "sweep " + dallara + " --from home --to patch --max-cells 200,300 --windows 2 --samples 20"});
   c.push_back({"help", "--help"});
   c.push_back({"version", "--version"});
-  for (const std::string sub : {"check", "fk", "ik", "plan", "bounds", "cf", "sweep", "params"})
+  for (const std::string sub :
+       {"check", "fk", "ik", "plan", "bounds", "cf", "sweep", "params", "render", "plot"})
     c.push_back({"help_" + sub, sub + " --help"});
   c.push_back({"help_import_urdf", "import-urdf --help"});
   c.push_back({"help_new_cell", "new-cell --help"});

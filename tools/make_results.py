@@ -5,7 +5,8 @@ beside the thesis's published tables (docs/data/thesis_tables.csv). Standard lib
 Usage: tools/make_results.py [--leeway build/leeway] [--samples 10000] [--out docs/results.md]
                              [--render-only]
 The sweeps' CSV files are kept in docs/data/results/ (with the machine line); --render-only
-rebuilds docs/results.md from them without running anything.
+rebuilds docs/results.md from them without running anything. The sweep plots it embeds
+(docs/images/sweep-*.svg) come from tools/make_figures.sh, which plots the recorded CSV files.
 Runs `leeway sweep --preset thesis` (no safety stage: the published method) for every (cell, path)
 in two configurations: the thesis's parameters (section 4.1, with each cell's own reach radius and
 the DLR obstacle-box option) and the same with volume.trail_margin = 0.1 m. Takes several minutes
@@ -127,6 +128,13 @@ def main():
         o.append(safety.read_text())
     for cell, src, dst, table in PATHS:
         o.append(f"## {cell.capitalize() if cell != 'dlr' else 'DLR'} {src}-{dst} (thesis table {table})\n")
+        plot = f"images/sweep-{cell}-{src}-{dst}.svg"
+        if (ROOT / "docs" / plot).exists():
+            o.append(f"![{cell} {src}-{dst}: boxes, time [ms] and CF [%] against MAX_cells, leeway's two "
+                     f"configurations beside thesis table {table}]({plot})\n")
+            o.append(f"*`{cell}-{src}-{dst}-thesis` and `-margin`: leeway's two configurations (the CSV files "
+                     f"in docs/data/results/); the third series is the thesis's table {table}, measured on "
+                     "its i5-8250U. Drawn by `leeway plot` (tools/make_figures.sh).*\n")
         o.append("| Max CBox | thesis CBox | thesis ms | thesis CF | CBox | ms | CF | 95 % CI | worst window | "
                  "collapsed | width | margin: CBox | ms | CF | worst window | collapsed | width |")
         o.append("|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")

@@ -37,6 +37,11 @@ std::vector<std::string> take_mujoco_warnings();
 //! @throws InputError naming the file when it is missing, unreadable or does not compile.
 ModelPtr load_model_file(const std::string& path);
 
+//! Compiles MJCF text as if it were the file `virtual_path` (through MuJoCo's virtual file system),
+//! so that its relative includes and asset paths resolve against that file's folder.
+//! @throws InputError "VIRTUAL_PATH: MJCF does not compile: ..." (one line) when MuJoCo rejects it.
+ModelPtr load_model_text(const std::string& xml, const std::string& virtual_path);
+
 //! Allocates an mjData for a model. @throws std::bad_alloc when MuJoCo cannot allocate it.
 DataPtr make_data(const mjModel& model);
 

@@ -7,6 +7,7 @@
 
 #include "leeway/bounds_file.hpp"
 #include "leeway/endpoints.hpp"
+#include "leeway/export_mjcf.hpp"
 #include "leeway/file_io.hpp"
 #include "leeway/nominal_path.hpp"
 #include "leeway/path_check.hpp"
@@ -79,6 +80,9 @@ CLI::App* add_bounds(CLI::App& app, BoundsArgs& args) {
   sub->add_option("--params", args.params, "Parameter file (JSON; see leeway params)");
   add_preset_options(sub, args.preset, args.safety);
   sub->add_option("--out", args.out, "Write the bounds file here (JSON)");
+  sub->add_option("--export-mjcf", args.export_mjcf,
+                  "Write the cell with its volume as MJCF (named visual-only box geoms) for mujoco-simulate");
+  sub->add_option("--export-mjb", args.export_mjb, "Write the same model compiled, as MuJoCo's binary MJB");
   sub->add_option("--threads", args.threads, "Worker threads")->capture_default_str();
   sub->add_flag("--json", args.json, "Print the bounds file to standard output");
   sub->add_flag("--no-plan", args.no_plan,
@@ -96,6 +100,9 @@ int run_bounds(const BoundsArgs& args) {
   if (args.max_cells_given) p.height_map.max_cells = args.max_cells;
   p.validate();
   if (args.threads < 1) throw InputError("--threads " + std::to_string(args.threads) + " must be >= 1");
+  if (!args.out.empty()) require_output(args.out, "--out");
+  if (!args.export_mjcf.empty()) require_output(args.export_mjcf, "--export-mjcf", {".xml"});
+  if (!args.export_mjb.empty()) require_output(args.export_mjb, "--export-mjb", {".mjb"});
   std::vector<Eigen::VectorXd> path;
   std::string label = args.from + " -> " + args.to;
   const bool linear = args.path.empty() && !is_gripper_goal(args.from) && !is_gripper_goal(args.to);
@@ -202,7 +209,13 @@ int run_bounds(const BoundsArgs& args) {
   const auto run = compute_bounds(scene, world, path, p, args.threads);
   json out = bounds_json(scene, run, p);
   out["nominal_path"] = nominal;
+  // The exports first: the MJB compiles the model and may fail; then nothing else is written.
+  std::string mjcf, mjb;
+  if (!args.export_mjcf.empty()) mjcf = volume_mjcf(scene.source(), run.volume.boxes, args.export_mjcf);
+  if (!args.export_mjb.empty()) mjb = volume_mjb(scene.source(), run.volume.boxes, args.export_mjb);
   if (!args.out.empty()) write_file_atomic(args.out, out.dump(2) + "\n");
+  if (!args.export_mjcf.empty()) write_file_atomic(args.export_mjcf, mjcf);
+  if (!args.export_mjb.empty()) write_file_atomic(args.export_mjb, mjb);
   if (args.json) {
     std::cout << out.dump(2) << "\n";
     return kExitOk;
@@ -226,6 +239,10 @@ int run_bounds(const BoundsArgs& args) {
             << run.ms_volume << ", inject " << run.ms_inject << ", bounds " << run.ms_bounds << ", safety "
             << run.ms_safety << ", total " << run.ms_total() << "\n";
   if (!args.out.empty()) std::cout << "wrote " << args.out << "\n";
+  for (const auto& file : {args.export_mjcf, args.export_mjb})
+    if (!file.empty())
+      std::cout << "wrote " << file << " (the cell with " << run.volume.boxes.size()
+                << " volume boxes in body '" << kExportBodyName << "')\n";
   return kExitOk;
 }
 

@@ -20,6 +20,8 @@ struct BoundsArgs {
   std::string preset = "leeway";     //!< parameter set
   std::string safety;                //!< safety mode; empty: the preset's
   std::string out;                   //!< bounds file to write (JSON); empty: none
+  std::string export_mjcf;           //!< the cell with its volume as MJCF; empty: none
+  std::string export_mjb;            //!< the same compiled, as MJB; empty: none
   int max_cells = 0;                 //!< MAX_cells, used when max_cells_given
   bool max_cells_given = false;      //!< --max-cells was on the command line (set by the parser)
   int waypoints = 2;                 //!< waypoints of the joint-linear path

@@ -1,6 +1,9 @@
 #include "cli/common.hpp"
 
+#include <unistd.h>
 #include <algorithm>
+#include <filesystem>
+#include <regex>
 #include <thread>
 #include <tuple>
 
@@ -98,6 +101,37 @@ bool plan_between(const Scene& scene, const std::string& from, const std::string
     return false;
   }
   return true;
+}
+
+void require_output(const std::string& path, const std::string& flag,
+                    const std::vector<std::string>& extensions) {
+  namespace fs = std::filesystem;
+  if (path.empty()) throw InputError(flag + ": the output file name is empty");
+  if (!extensions.empty()) {
+    const std::string ext = fs::path(path).extension().string();
+    if (std::find(extensions.begin(), extensions.end(), ext) == extensions.end()) {
+      std::string listed;
+      for (const auto& e : extensions) listed += (listed.empty() ? "" : " or ") + e;
+      throw InputError(flag + " " + path + ": the file name must end in " + listed);
+    }
+  }
+  const fs::path folder = fs::path(path).has_parent_path() ? fs::path(path).parent_path() : fs::path(".");
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec) || ::access(folder.c_str(), W_OK) != 0)
+    throw InputError(flag + " " + path + ": cannot write there (folder '" + folder.string() +
+                     "' missing or not writable)");
+  if (fs::is_directory(path, ec)) throw InputError(flag + " " + path + ": is a folder, not a file");
+}
+
+std::pair<int, int> parse_size(const std::string& text, const std::string& flag) {
+  static const std::regex re("([0-9]{1,5})[xX]([0-9]{1,5})");
+  std::smatch m;
+  if (!std::regex_match(text, m, re))
+    throw InputError(flag + " '" + text + "' must be WIDTHxHEIGHT in pixels, e.g. 1280x960");
+  const int w = std::stoi(m[1]), h = std::stoi(m[2]);
+  if (w < 16 || w > 8192 || h < 16 || h > 8192)
+    throw InputError(flag + " '" + text + "': width and height must be from 16 to 8192 pixels");
+  return {w, h};
 }
 
 }  // namespace leeway::cli

@@ -9,6 +9,8 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "leeway/endpoints.hpp"
 #include "leeway/error.hpp"
@@ -94,5 +96,14 @@ bool is_gripper_goal(const std::string& spec);
 bool plan_between(const Scene& scene, const std::string& from, const std::string& to,
                   const std::string& ik_seed_key, const PlanOptions& options, PlanResult& result, Endpoint& a,
                   Endpoint& b);
+
+//! Checks, before any work, that an output file can be written: its folder exists and is writable
+//! and, when `extensions` is not empty, its name ends in one of them (".png"). `flag` names the option.
+//! @throws InputError naming the flag and the path otherwise.
+void require_output(const std::string& path, const std::string& flag,
+                    const std::vector<std::string>& extensions = {});
+
+//! Parses an image size "WIDTHxHEIGHT" [pixels]. @throws InputError naming `flag` and the value.
+std::pair<int, int> parse_size(const std::string& text, const std::string& flag);
 
 }  // namespace leeway::cli

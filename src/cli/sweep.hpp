@@ -24,6 +24,7 @@ struct SweepArgs {
   std::string preset = "leeway";         //!< parameter set
   std::string safety;                    //!< safety mode; empty: the preset's
   std::string csv;                       //!< CSV file to write too; empty: none
+  std::string plot;                      //!< sweep plot to write (.svg or .png); empty: none
   int threads = default_threads();       //!< worker threads
   CfParams cf;                           //!< CF windows, samples, seed (those given on the command line)
   bool windows_given = false, samples_given = false, seed_given = false;  //!< set by the parser

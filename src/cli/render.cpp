@@ -1,0 +1,197 @@
+#include "cli/render.hpp"
+
+#include <cmath>
+#include <iostream>
+
+#include "leeway/nominal_path.hpp"
+#include "leeway/path_check.hpp"
+#include "leeway/pipeline.hpp"
+#include "leeway/render.hpp"
+
+namespace leeway::cli {
+namespace {
+
+// Height [m] the default camera frames without a volume (an industrial arm's reach upwards).
+constexpr double kRobotHeight = 2.5;
+
+// The robot's base on the floor at q: the first hinge joint's anchor (the reach circle's centre).
+Eigen::Vector2d arm_base(const Scene& scene, const Eigen::VectorXd& q) {
+  DataPtr d = make_data(scene.model());
+  scene.set_qpos(*d, q);
+  mj_kinematics(&scene.model(), d.get());
+  for (const auto& j : scene.joints())
+    if (!j.prismatic) return {d->xanchor[3 * j.id], d->xanchor[3 * j.id + 1]};
+  return {0, 0};
+}
+
+}  // namespace
+
+CLI::App* add_render(CLI::App& app, RenderArgs& args) {
+  CLI::App* sub = app.add_subcommand(
+      "render",
+      "An offscreen picture (PNG, no display needed) of the cell with the robot at a waypoint and, with\n"
+      "bounds (--bounds, or --from/--to computed as leeway bounds does), the volume's boxes coloured by\n"
+      "height and ghosts of the robot at the extremes of its intervals. Exit 0 on success, 1 when the\n"
+      "straight path between the keyframes collides, 2 bad input (nothing written).");
+  sub->add_option("cell", args.cell, "MJCF file of the workcell")->required();
+  auto* bounds = sub->add_option("--bounds", args.bounds, "Bounds file written by leeway bounds --out");
+  sub->add_option("--from", args.from, "Keyframe the path starts at (bounds computed here)")
+      ->excludes(bounds);
+  sub->add_option("--to", args.to, "Keyframe the path ends at")->excludes(bounds);
+  sub->add_option("--key", args.key, "Keyframe to show without bounds (default: the cell's first)")
+      ->excludes(bounds);
+  sub->add_option("--out", args.out, "PNG file to write")->required();
+  sub->add_option("--waypoint", args.waypoint, "Waypoint shown, from 0 (default: the last)");
+  sub->add_option("--camera", args.camera,
+                  "Camera \"az,el,dist\": azimuth and elevation [rad] (elevation < 0 looks down), distance\n"
+                  "[m] (default: -2.4,-0.9 and a distance that frames the reach circle)");
+  sub->add_option("--lookat", args.lookat,
+                  "Point the camera looks at, \"x,y,z\" [m] (default: the reach circle's centre)");
+  sub->add_option("--size", args.size, "Image size WIDTHxHEIGHT [pixels]")->capture_default_str();
+  sub->add_option("--volume", args.volume, "Draw the volume: on or off (the thesis's fig. 3.4 after/before)")
+      ->capture_default_str();
+  sub->add_option("--ghosts", args.ghosts,
+                  "Ghosts of the robot: corners (all joints at their lower, all at their upper bound),\n"
+                  "joints (each joint at each bound) or none")
+      ->capture_default_str();
+  sub->add_option("--waypoints", args.waypoints, "Waypoints along the joint-linear path (with --from/--to)")
+      ->capture_default_str();
+  sub->add_option("--max-cells", args.max_cells, "MAX_cells of the height-map (with --from/--to)");
+  sub->add_option("--params", args.params, "Parameter file (JSON; with --from/--to)");
+  add_preset_options(sub, args.preset, args.safety);
+  sub->add_option("--threads", args.threads, "Worker threads")->capture_default_str();
+  sub->final_callback([sub, &args] { args.max_cells_given = sub->count("--max-cells") > 0; });
+  return sub;
+}
+
+int run_render(const RenderArgs& args) {
+  // Every flag is checked before any work, so that bad input writes nothing.
+  require_output(args.out, "--out", {".png"});
+  const auto [width, height] = parse_size(args.size, "--size");
+  if (args.volume != "on" && args.volume != "off")
+    throw InputError("--volume '" + args.volume + "' must be on or off");
+  GhostMode ghosts = GhostMode::kNone;
+  if (args.ghosts == "corners")
+    ghosts = GhostMode::kCorners;
+  else if (args.ghosts == "joints")
+    ghosts = GhostMode::kJoints;
+  else if (args.ghosts != "none")
+    throw InputError("--ghosts '" + args.ghosts + "' must be corners, joints or none");
+  RenderCamera camera;
+  bool camera_given = false;
+  if (!args.camera.empty()) {
+    const Eigen::VectorXd c = parse_vector(args.camera, "--camera");
+    if (c.size() != 3)
+      throw InputError("--camera '" + args.camera +
+                       "' must be three numbers: azimuth [rad], elevation [rad], distance [m]");
+    if (!(c[2] > 0)) throw InputError("--camera distance " + format_number(c[2]) + " m must be > 0");
+    if (std::abs(c[1]) > 1.5707963267948966)
+      throw InputError("--camera elevation " + format_number(c[1]) + " rad must be within [-pi/2, pi/2]");
+    camera.azimuth = c[0];
+    camera.elevation = c[1];
+    camera.distance = c[2];
+    camera_given = true;
+  }
+  Eigen::Vector3d lookat;
+  if (!args.lookat.empty()) {
+    const Eigen::VectorXd v = parse_vector(args.lookat, "--lookat");
+    if (v.size() != 3) throw InputError("--lookat '" + args.lookat + "' must be three numbers x,y,z [m]");
+    lookat = v;
+  }
+  const bool with_path = !args.from.empty() || !args.to.empty();
+  if (with_path && (args.from.empty() || args.to.empty()))
+    throw InputError("--from and --to go together (two keyframes)");
+  if (with_path && !args.key.empty())
+    throw InputError("--key shows a keyframe without bounds: not with --from/--to");
+  if (!with_path && args.bounds.empty() && args.waypoint != -1)
+    throw InputError("--waypoint " + std::to_string(args.waypoint) +
+                     ": there is no path without --bounds or --from/--to");
+  if (args.threads < 1) throw InputError("--threads " + std::to_string(args.threads) + " must be >= 1");
+
+  const auto scene = Scene::load(args.cell, scene_options(kDefaultTool));
+  Params p = load_params(scene, args.preset, args.params, args.safety);
+  if (args.max_cells_given) p.height_map.max_cells = args.max_cells;
+  p.validate();
+  const bool show_volume = args.volume == "on";
+
+  std::vector<WaypointBounds> bounds;
+  Volume volume;
+  std::string what;
+  if (!args.bounds.empty()) {
+    BoundsFileVolume file = read_bounds_volume(args.bounds, scene, /*require_volume=*/show_volume);
+    bounds = std::move(file.bounds);
+    volume = std::move(file.volume);
+    p = file.params;
+    what = args.bounds;
+  } else if (with_path) {
+    if (args.waypoints < 2)
+      throw InputError("--waypoints " + std::to_string(args.waypoints) + " must be >= 2");
+    if (args.waypoint >= args.waypoints)
+      throw InputError("--waypoint " + std::to_string(args.waypoint) + ": the path has " +
+                       std::to_string(args.waypoints) + " waypoints (0 .. " +
+                       std::to_string(args.waypoints - 1) + ")");
+    const auto path = keyframe_path(scene, args.from, args.to, args.waypoints);
+    if (const auto checked = check_path(scene, path); !checked.free()) {
+      std::cerr
+          << "leeway: collision: " << scene.source() << ": the straight path from " << args.from << " to "
+          << args.to << " " << describe_collision(scene, *checked.collision, true)
+          << "; bound a planned path with leeway bounds --out and render it with --bounds; nothing written\n";
+      return kExitFindings;
+    }
+    VolumeModel world(scene, p.height_map.max_cells + static_cast<int>(scene.obstacle_geoms().size()));
+    BoundsRun run = compute_bounds(scene, world, path, p, args.threads);
+    bounds = std::move(run.bounds);
+    volume = std::move(run.volume);
+    what = args.from + " -> " + args.to;
+  }
+  const int n = static_cast<int>(bounds.size());
+  if (!bounds.empty() && (args.waypoint < -1 || args.waypoint >= n))
+    throw InputError("--waypoint " + std::to_string(args.waypoint) + ": " + what + " has " +
+                     std::to_string(n) + " waypoints (0 .. " + std::to_string(n - 1) + ")");
+  const int k = args.waypoint == -1 ? n - 1 : args.waypoint;
+
+  RenderRequest request;
+  request.width = width;
+  request.height = height;
+  if (bounds.empty()) {
+    request.q = !args.key.empty()            ? scene.keyframe(args.key).q
+                : !scene.keyframes().empty() ? scene.keyframes().front().q
+                                             : Eigen::VectorXd::Zero(scene.dof());
+  } else {
+    request.q = bounds[static_cast<size_t>(k)].q;
+    request.ghosts = ghost_configurations(bounds[static_cast<size_t>(k)], ghosts);
+  }
+  if (show_volume) request.volume = volume.boxes;
+
+  // Default framing: the volume's height-map when there is one (also with --volume off, so that
+  // both views of fig. 3.4 share the camera), else the reach circle at q.
+  const double fovy = scene.model().vis.global.fovy * 3.14159265358979323846 / 180;
+  RenderCamera framed;
+  if (volume.grid.rows > 0) {
+    const Grid& g = volume.grid;
+    const Eigen::Vector2d centre(g.origin_x + 0.5 * g.rows * g.side, g.origin_y + 0.5 * g.cols * g.side);
+    double top = kRobotHeight;
+    for (const Box& b : volume.boxes) top = std::max(top, b.center.z() + b.half_size.z());
+    framed = frame_circle(centre, 0.5 * std::max(g.rows, g.cols) * g.side, top, fovy);
+  } else {
+    framed = frame_circle(arm_base(scene, request.q), p.volume.reach_radius, kRobotHeight, fovy);
+  }
+  if (!camera_given) {
+    camera.distance = framed.distance;
+  }
+  camera.lookat = args.lookat.empty() ? framed.lookat : lookat;
+  request.camera = camera;
+
+  const Image image = render_scene(scene, request);
+  write_png(args.out, image);
+  std::cout << "wrote " << args.out << " (" << width << "x" << height << " pixels; "
+            << (bounds.empty() ? "no bounds" : "waypoint " + std::to_string(k) + " of " + what) << ", "
+            << request.volume.size() << " volume boxes, " << request.ghosts.size() << " ghosts; camera "
+            << format_number(camera.azimuth) << "," << format_number(camera.elevation) << ","
+            << format_number(camera.distance) << " [rad, rad, m], look-at "
+            << format_number(camera.lookat.x()) << "," << format_number(camera.lookat.y()) << ","
+            << format_number(camera.lookat.z()) << " [m])\n";
+  return kExitOk;
+}
+
+}  // namespace leeway::cli

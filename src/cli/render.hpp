@@ -1,0 +1,41 @@
+#pragma once
+// `leeway render`: an offscreen picture of the cell, the robot at a waypoint, the volume and ghosts.
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "cli/common.hpp"
+
+namespace leeway::cli {
+
+//! The command line of `leeway render`.
+struct RenderArgs {
+  std::string cell;                 //!< MJCF file of the workcell
+  std::string bounds;               //!< bounds file (its nominal path, intervals and volume)
+  std::string from, to;             //!< keyframes of a path to bound instead
+  std::string key;                  //!< keyframe to show without bounds (default: the first)
+  std::string out;                  //!< PNG file to write
+  int waypoint = -1;                //!< waypoint shown; -1: the last
+  std::string camera;               //!< "az,el,dist" [rad, rad, m]; empty: framing the reach circle
+  std::string lookat;               //!< "x,y,z" [m]; empty: the reach circle's centre
+  std::string size = "1280x960";    //!< image size [pixels]
+  std::string volume = "on";        //!< draw the volume: on or off
+  std::string ghosts = "corners";   //!< ghosts: corners, joints or none
+  std::string params;               //!< parameter file (with --from/--to)
+  std::string preset = "leeway";    //!< parameter set (with --from/--to)
+  std::string safety;               //!< safety mode (with --from/--to); empty: the preset's
+  int max_cells = 0;                //!< MAX_cells, used when max_cells_given
+  bool max_cells_given = false;     //!< --max-cells was on the command line (set by the parser)
+  int waypoints = 2;                //!< waypoints of the joint-linear path (with --from/--to)
+  int threads = default_threads();  //!< worker threads
+};
+
+//! Adds the `render` subcommand, parsing into `args`; returns it.
+CLI::App* add_render(CLI::App& app, RenderArgs& args);
+
+//! Runs `leeway render`: writes the PNG and returns kExitOk; kExitFindings when the straight path
+//! between the keyframes collides (nothing written).
+//! @throws InputError on a bad cell, bounds file, waypoint, camera, size or output path.
+int run_render(const RenderArgs& args);
+
+}  // namespace leeway::cli

@@ -1,0 +1,344 @@
+// The picture subcommands as a user runs them (issue 11): leeway render, leeway plot, sweep --plot
+// and bounds --export-mjcf/--export-mjb; their files, and their bad input (exit 2, nothing written).
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "leeway/export_mjcf.hpp"
+#include "leeway/render.hpp"
+#include "leeway/scene.hpp"
+#include "png_util.hpp"
+#include "test_util.hpp"
+
+namespace leeway {
+namespace {
+
+using test::run_cli;
+using test::workcell;
+using ::testing::HasSubstr;
+namespace fs = std::filesystem;
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Counts, with python3's XML parser, the elements of an SVG file matching each XPath (ElementTree's
+// subset, SVG namespace as "s:"); "error" when the file does not parse.
+std::string svg_counts(const std::string& file, const std::vector<std::string>& paths) {
+  std::string list;
+  for (const auto& p : paths) list += (list.empty() ? "" : ",") + ("\"" + p + "\"");
+  const std::string script =
+      "import sys, xml.etree.ElementTree as E\n"
+      "ns = {'s': 'http://www.w3.org/2000/svg'}\n"
+      "try:\n"
+      "    r = E.parse(sys.argv[1]).getroot()\n"
+      "except E.ParseError as e:\n"
+      "    print('error', e); sys.exit(0)\n"
+      "print(' '.join(str(len(r.findall(p, ns))) for p in [" +
+      list + "]))\n";
+  test::TempDir dir;
+  const std::string py = dir.write("count.py", script);
+  return test::run_program("python3", py + " " + file).out;
+}
+
+class CliRenderTest : public test::MujocoTest {
+ protected:
+  //! Bounds home -> patch on the Dallara cell with the thesis's parameters at MAX_cells 2000.
+  std::string bounds_file(const std::string& extra = "") {
+    const std::string out = path("b.json");
+    if (!fs::exists(out)) {
+      const auto r =
+          run_cli("bounds " + workcell("dallara") +
+                  " --from home --to patch --preset thesis --max-cells 2000 --out " + out + " " + extra);
+      EXPECT_EQ(r.exit_code, 0) << r.out;
+    }
+    return out;
+  }
+  std::string path(const std::string& name) const { return (dir_.path() / name).string(); }
+  test::TempDir dir_;
+};
+
+TEST_F(CliRenderTest, VolumeColourWhereAVolumeBoxProjectsAndNotWithVolumeOff) {
+  const std::string b = bounds_file();
+  const std::string camera = " --size 320x240 --camera 0,-1.5,14 --lookat 0,0,0";
+  const auto on =
+      run_cli("render " + workcell("dallara") + " --bounds " + b + " --out " + path("on.png") + camera);
+  ASSERT_EQ(on.exit_code, 0) << on.out;
+  EXPECT_THAT(on.out, HasSubstr("320x240 pixels"));
+  const auto off = run_cli("render " + workcell("dallara") + " --bounds " + b + " --out " + path("off.png") +
+                           camera + " --volume off");
+  ASSERT_EQ(off.exit_code, 0) << off.out;
+  EXPECT_EQ(png_size(path("on.png")), (std::array<int, 2>{320, 240}));
+  const Image img_on = test::read_png(path("on.png")), img_off = test::read_png(path("off.png"));
+
+  // The volume the render drew, regenerated from the bounds file; its highest box is the yellow end
+  // of the colour scale. Check the boxes from the highest down whose top centre falls on bare floor
+  // in the render without the volume (grey: the robot and tables are orange and brown).
+  const Scene scene = Scene::load(workcell("dallara"));
+  const BoundsFileVolume v = read_bounds_volume(b, scene);
+  ASSERT_EQ(static_cast<int>(v.volume.boxes.size()), v.recorded_boxes);
+  std::vector<Box> boxes = v.volume.boxes;
+  double max_top = 0;
+  for (const Box& box : boxes) max_top = std::max(max_top, box.center.z() + box.half_size.z());
+  std::sort(boxes.begin(), boxes.end(), [](const Box& p, const Box& q) {
+    return p.center.z() + p.half_size.z() > q.center.z() + q.half_size.z();
+  });
+  RenderCamera cam;
+  cam.azimuth = 0;
+  cam.elevation = -1.5;
+  cam.distance = 14;
+  cam.lookat = Eigen::Vector3d::Zero();
+  const double fovy = scene.model().vis.global.fovy * kPi / 180;
+  int checked = 0;
+  for (const Box& box : boxes) {
+    Eigen::Vector2d px;
+    const Eigen::Vector3d top = box.center + Eigen::Vector3d(0, 0, box.half_size.z());
+    if (!project_point(cam, fovy, 320, 240, top, px)) continue;
+    const int x = static_cast<int>(px.x()), y = static_cast<int>(px.y());
+    if (x < 2 || x >= 318 || y < 2 || y >= 238) continue;
+    const auto floor = img_off.at(x, y);
+    if (std::max({floor[0], floor[1], floor[2]}) - std::min({floor[0], floor[1], floor[2]}) > 12) continue;
+    // Volume on: the pixel moves from the floor's grey towards the box's colour.
+    const auto c = height_colour(top.z(), max_top);
+    const auto p = img_on.at(x, y);
+    double d_on = 0, d_off = 0;
+    for (size_t k = 0; k < 3; ++k) {
+      d_on += std::pow(p[k] - 255.0 * c[k], 2);
+      d_off += std::pow(floor[k] - 255.0 * c[k], 2);
+    }
+    EXPECT_LT(std::sqrt(d_on), std::sqrt(d_off) - 25)
+        << "box at (" << box.center.transpose() << ") pixel " << x << "," << y << ": on " << int{p[0]} << " "
+        << int{p[1]} << " " << int{p[2]} << ", off " << int{floor[0]} << " " << int{floor[1]} << " "
+        << int{floor[2]};
+    if (++checked == 5) break;
+  }
+  EXPECT_EQ(checked, 5);
+}
+
+TEST_F(CliRenderTest, FromToComputesTheBoundsAndBareCellRenders) {
+  const auto r =
+      run_cli("render " + workcell("dallara") +
+              " --from home --to patch --preset thesis --max-cells 500 --waypoint 0 --size 64x48 --out " +
+              path("ft.png"));
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_THAT(r.out, HasSubstr("waypoint 0 of home -> patch"));
+  EXPECT_EQ(png_size(path("ft.png")), (std::array<int, 2>{64, 48}));
+  const auto bare =
+      run_cli("render " + workcell("dallara") + " --key patch --size 80x60 --out " + path("bare.png"));
+  ASSERT_EQ(bare.exit_code, 0) << bare.out;
+  EXPECT_THAT(bare.out, HasSubstr("0 volume boxes"));
+  EXPECT_EQ(png_size(path("bare.png")), (std::array<int, 2>{80, 60}));
+}
+
+TEST_F(CliRenderTest, BadInputExitsTwoAndWritesNothing) {
+  const std::string b = bounds_file();
+  const std::string out = path("bad.png");
+  const std::string cell = workcell("dallara") + " --bounds " + b;
+  struct Case {
+    std::string args, message;
+  };
+  const std::vector<Case> cases = {
+      {cell + " --out /nonexistent-folder/x.png", "cannot write there"},
+      {cell + " --out " + path("x.jpg"), "must end in .png"},
+      {cell + " --out " + out + " --waypoint 7", "--waypoint 7: " + b + " has 2 waypoints (0 .. 1)"},
+      {cell + " --out " + out + " --waypoint -2", "--waypoint -2"},
+      {workcell("baltico") + " --bounds " + b + " --out " + out, "computed for another cell"},
+      {cell + " --out " + out + " --size 12x", "--size '12x' must be WIDTHxHEIGHT"},
+      {cell + " --out " + out + " --size 8x8", "from 16 to 8192"},
+      {cell + " --out " + out + " --camera 1,nan,3", "--camera"},
+      {cell + " --out " + out + " --camera 1,2", "must be three numbers"},
+      {cell + " --out " + out + " --camera 1,-2,3", "elevation -2 rad"},
+      {cell + " --out " + out + " --camera 1,-1,0", "distance 0 m must be > 0"},
+      {cell + " --out " + out + " --lookat 0,0,inf", "--lookat"},
+      {cell + " --out " + out + " --volume maybe", "--volume 'maybe' must be on or off"},
+      {cell + " --out " + out + " --ghosts all", "--ghosts 'all'"},
+      {workcell("dallara") + " --from home --to nowhere --out " + out, "nowhere"},
+      {workcell("dallara") + " --from home --to patch --waypoint 2 --out " + out,
+       "--waypoint 2: the path has 2"},
+  };
+  for (const auto& c : cases) {
+    const auto r = run_cli("render " + c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args << "\n" << r.out;
+    EXPECT_THAT(r.out, HasSubstr(c.message)) << c.args;
+    EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+    EXPECT_FALSE(fs::exists(out)) << c.args;
+  }
+}
+
+TEST_F(CliRenderTest, PlotSvgParsesWithOneCurveSetPerJointAndPngHasItsSize) {
+  const std::string b = bounds_file();
+  const auto r = run_cli("plot " + b + " --out " + path("p.svg"));
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  // Six joint panels; each has one lower, one nominal and one upper curve.
+  EXPECT_EQ(svg_counts(path("p.svg"),
+                       {".//s:g[@class='joint']", ".//s:g[@class='joint']/s:polyline[@class='lower']",
+                        ".//s:g[@class='joint']/s:polyline[@class='nominal']",
+                        ".//s:g[@class='joint']/s:polyline[@class='upper']"}),
+            "6 6 6 6\n");
+  const auto png = run_cli("plot " + b + " --out " + path("p.png"));
+  ASSERT_EQ(png.exit_code, 0) << png.out;
+  EXPECT_EQ(png_size(path("p.png")), (std::array<int, 2>{1000, 60 + 3 * 240}));
+  const auto sized = run_cli("plot " + b + " --out " + path("q.png") + " --size 640x480");
+  ASSERT_EQ(sized.exit_code, 0) << sized.out;
+  EXPECT_EQ(png_size(path("q.png")), (std::array<int, 2>{640, 480}));
+}
+
+TEST_F(CliRenderTest, PlotMarksShrunkAndCollapsedIntervals) {
+  // A hand-made two-joint file: joint a shrunk by the safety stage at waypoint 1, joint b collapsed
+  // at waypoint 0.
+  const std::string b =
+      dir_.write("h.json", R"({"joints": ["a", "b"], "joint_bounding": ["bisected", "linear_axis"],
+    "waypoints": [
+      {"q": [0, 0], "lower": [-1, -0.01], "upper": [1, 0.01], "collapsed": ["b"]},
+      {"q": [0.5, 0.1], "lower": [0.2, 0], "upper": [0.9, 0.2], "guide_lower": [0, 0], "guide_upper": [1, 0.2]}]})");
+  const auto r = run_cli("plot " + b + " --out " + path("h.svg"));
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_EQ(
+      svg_counts(path("h.svg"), {".//s:g[@class='joint']", ".//s:polyline[@class='guide-lower']",
+                                 ".//s:circle[@class='collapsed']", ".//s:g[@data-joint='b']/s:polyline"}),
+      "2 1 1 3\n");
+  const std::string text = test::run_program("cat", path("h.svg")).out;
+  EXPECT_THAT(text, HasSubstr("b [m], linear_axis"));
+  EXPECT_THAT(text, HasSubstr("a [rad], bisected"));
+}
+
+TEST_F(CliRenderTest, PlotBadInput) {
+  const std::string b = bounds_file();
+  const std::string bad =
+      dir_.write("bad.json", R"({"joints": ["a"], "waypoints": [{"q": [0], "lower": [0.5], "upper": [1]}]})");
+  const std::string short_file = dir_.write(
+      "short.json", R"({"joints": ["a", "b"], "waypoints": [{"q": [0], "lower": [0], "upper": [1]}]})");
+  const std::string nan_file =
+      dir_.write("nan.json", R"({"joints": ["a"], "waypoints": [{"q": [NaN], "lower": [0], "upper": [1]}]})");
+  struct Case {
+    std::string args, message;
+  };
+  const std::vector<Case> cases = {
+      {b + " --out " + path("p.txt"), "must end in .svg or .png"},
+      {b + " --out /nonexistent-folder/p.svg", "cannot write there"},
+      {b + " --out " + path("p.svg") + " --size 0x100", "--size '0x100'"},
+      {bad + " --out " + path("p.svg"), "nominal 0 is not within [0.5, 1]"},
+      {short_file + " --out " + path("p.svg"), "waypoint 0 'q' has 1 values, 'joints' names 2"},
+      {nan_file + " --out " + path("p.svg"), "malformed JSON"},
+  };
+  for (const auto& c : cases) {
+    const auto r = run_cli("plot " + c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args << "\n" << r.out;
+    EXPECT_THAT(r.out, HasSubstr(c.message)) << c.args;
+    EXPECT_FALSE(fs::exists(path("p.svg")));
+  }
+}
+
+TEST_F(CliRenderTest, SweepPlotHasTheThesisSeriesForOneOfTheNineCases) {
+  const std::string common = " --preset thesis --max-cells 100,300 --samples 50 --windows 2 --threads 2";
+  auto r = run_cli("sweep " + workcell("dallara") + " --from home --to patch" + common + " --plot " +
+                   path("s.svg"));
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  // Three panels (boxes, time, CF), each with leeway's series (2 points) and table 4.1's.
+  EXPECT_EQ(svg_counts(path("s.svg"), {".//s:g[@class='panel']", ".//s:polyline[@data-series='leeway']",
+                                       ".//s:polyline[@class='series']"}),
+            "3 3 6\n");
+  EXPECT_THAT(test::run_program("cat", path("s.svg")).out, HasSubstr("thesis, table 4.1"));
+  // patch -> home is not one of the nine: leeway's series only.
+  r = run_cli("sweep " + workcell("dallara") + " --from patch --to home" + common + " --plot " +
+              path("t.svg"));
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_EQ(svg_counts(path("t.svg"), {".//s:g[@class='panel']", ".//s:polyline[@class='series']"}), "3 3\n");
+  r = run_cli("sweep " + workcell("dallara") + " --from home --to patch" + common + " --plot " +
+              path("s.pdf"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.out, HasSubstr("must end in .svg or .png"));
+}
+
+TEST_F(CliRenderTest, PlotOfSweepCsvFilesBesideTheThesisTable) {
+  const std::string a =
+      dir_.write("a.csv", "max_cells,boxes,time_ms,cf\n100,60,18.3,0.9\n1000,600,80,0.99\n");
+  const std::string b = dir_.write("b.csv", "max_cells,boxes,time_ms,cf,extra\n100,50,10,0.95,x\n");
+  auto r = run_cli("plot " + a + " " + b + " --thesis dlr/mould-home --out " + path("s.svg"));
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  // Three panels with three series each: a, b and table 4.9.
+  EXPECT_EQ(svg_counts(path("s.svg"), {".//s:g[@class='panel']", ".//s:polyline[@data-series='a']",
+                                       ".//s:polyline[@data-series='thesis, table 4.9 (i5-8250U)']"}),
+            "3 3 3\n");
+  // CF 0.9 and 0.99 are plotted as 90 and 99 %: padded by 5 % to [89.55, 99.45], ticks every 2 %.
+  r = run_cli("plot " + a + " --out " + path("a.svg"));
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const std::string svg = test::run_program("cat", path("a.svg")).out;
+  EXPECT_THAT(svg, HasSubstr(">90</text>"));
+  EXPECT_THAT(svg, HasSubstr(">98</text>"));
+  const std::string bad = dir_.write("bad.csv", "max_cells,boxes,cf\n100,60,0.9\n");
+  const std::string nan = dir_.write("nan.csv", "max_cells,boxes,time_ms,cf\n100,60,nan,0.9\n");
+  struct Case {
+    std::string args, message;
+  };
+  const std::vector<Case> cases = {
+      {bad + " --out " + path("t.svg"), "bad.csv: line 1 has no column 'time_ms'"},
+      {nan + " --out " + path("t.svg"), "nan.csv: line 2 column 'time_ms': 'nan' is not a finite number"},
+      {a + " --thesis dallara/home-mould --out " + path("t.svg"), "--thesis 'dallara/home-mould'"},
+      {a + " " + bounds_file() + " --out " + path("t.svg"), "not both"},
+  };
+  for (const auto& c : cases) {
+    r = run_cli("plot " + c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args << "\n" << r.out;
+    EXPECT_THAT(r.out, HasSubstr(c.message)) << c.args;
+    EXPECT_FALSE(fs::exists(path("t.svg")));
+  }
+}
+
+TEST_F(CliRenderTest, ExportedMjcfAndMjbCompileWithTheFilesBoxes) {
+  fs::create_directories(dir_.path() / "elsewhere");
+  const std::string xml = path("elsewhere/volume.xml"), mjb = path("volume.mjb");
+  bounds_file("--export-mjcf " + xml + " --export-mjb " + mjb);
+  const int boxes = test::read_json(path("b.json")).at("boxes").get<int>();
+  ASSERT_GT(boxes, 100);
+  for (const std::string& file : {xml, mjb}) {
+    SCOPED_TRACE(file);
+    const ModelPtr m = load_model_file(file);  // the fixture fails the test on any MuJoCo warning
+    const int body = mj_name2id(m.get(), mjOBJ_BODY, kExportBodyName);
+    ASSERT_GE(body, 0);
+    EXPECT_EQ(m->body_geomnum[body], boxes);
+    const int g = m->body_geomadr[body];
+    EXPECT_EQ(object_name(*m, mjOBJ_GEOM, g), "leeway_volume_box_0");
+    EXPECT_EQ(object_name(*m, mjOBJ_GEOM, g + boxes - 1), "leeway_volume_box_" + std::to_string(boxes - 1));
+    for (int k = g; k < g + boxes; ++k) {
+      ASSERT_EQ(m->geom_type[k], mjGEOM_BOX);
+      ASSERT_EQ(m->geom_contype[k], 0);
+      ASSERT_EQ(m->geom_conaffinity[k], 0);
+    }
+    // The cell itself is still there: the robot and the tables.
+    EXPECT_GE(mj_name2id(m.get(), mjOBJ_GEOM, "patch_table"), 0);
+    EXPECT_GE(mj_name2id(m.get(), mjOBJ_JOINT, "j1"), 0);
+  }
+}
+
+TEST_F(CliRenderTest, ExportOfACellWithNestedIncludesCompilesInAnotherFolder) {
+  // DLR's cell includes the rail robot, which includes the arm: MuJoCo resolves both against the
+  // main file's folder, so the export inlines them.
+  const std::string xml = path("dlr-volume.xml");
+  const auto r =
+      run_cli("bounds " + workcell("dlr") + " --from home --to patch --preset thesis --max-cells 300 --json" +
+              " --export-mjcf " + xml);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const ModelPtr m = load_model_file(xml);
+  EXPECT_GE(mj_name2id(m.get(), mjOBJ_BODY, kExportBodyName), 0);
+  EXPECT_GE(mj_name2id(m.get(), mjOBJ_JOINT, "rail_x"), 0);
+}
+
+TEST_F(CliRenderTest, ExportBadPathWritesNothing) {
+  const auto r =
+      run_cli("bounds " + workcell("dallara") + " --from home --to patch --preset thesis --max-cells 300" +
+              " --out " + path("b.json") + " --export-mjcf /nonexistent-folder/v.xml");
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_THAT(r.out, HasSubstr("--export-mjcf /nonexistent-folder/v.xml: cannot write there"));
+  EXPECT_FALSE(fs::exists(path("b.json")));
+  const auto ext =
+      run_cli("bounds " + workcell("dallara") + " --from home --to patch --preset thesis --max-cells 300" +
+              " --export-mjb " + path("v.xml"));
+  EXPECT_EQ(ext.exit_code, 2) << ext.out;
+  EXPECT_THAT(ext.out, HasSubstr("must end in .mjb"));
+}
+
+}  // namespace
+}  // namespace leeway

@@ -1,0 +1,60 @@
+#pragma once
+// Test support: a PNG reader for the files leeway writes (8-bit RGB, filter type 0 on every row).
+
+#include <zlib.h>
+
+#include <fstream>
+#include <iterator>
+#include <stdexcept>
+#include <string>
+
+#include "leeway/render.hpp"
+
+namespace leeway::test {
+
+//! Decodes a PNG written by leeway::encode_png; throws std::runtime_error on anything else.
+inline Image decode_png(const std::string& bytes) {
+  if (bytes.compare(0, 8, std::string("\x89PNG\r\n\x1a\n", 8)) != 0)
+    throw std::runtime_error("no PNG signature");
+  auto u32 = [&bytes](size_t at) {
+    unsigned v = 0;
+    for (size_t k = 0; k < 4; ++k) v = (v << 8) | static_cast<unsigned char>(bytes.at(at + k));
+    return v;
+  };
+  Image image;
+  std::string packed;
+  for (size_t at = 8; at + 8 <= bytes.size();) {
+    const size_t len = u32(at);
+    const std::string type = bytes.substr(at + 4, 4);
+    if (type == "IHDR") {
+      image.width = static_cast<int>(u32(at + 8));
+      image.height = static_cast<int>(u32(at + 12));
+      if (bytes.substr(at + 16, 5) != std::string("\x08\x02\x00\x00\x00", 5))
+        throw std::runtime_error("not 8-bit RGB without interlace");
+    }
+    if (type == "IDAT") packed += bytes.substr(at + 8, len);
+    at += 12 + len;
+  }
+  const size_t row = 3 * static_cast<size_t>(image.width);
+  std::string raw((row + 1) * static_cast<size_t>(image.height), '\0');
+  uLongf size = static_cast<uLongf>(raw.size());
+  if (uncompress(reinterpret_cast<Bytef*>(raw.data()), &size, reinterpret_cast<const Bytef*>(packed.data()),
+                 static_cast<uLong>(packed.size())) != Z_OK ||
+      size != raw.size())
+    throw std::runtime_error("IDAT does not inflate to the image size");
+  for (int y = 0; y < image.height; ++y) {
+    const size_t start = (row + 1) * static_cast<size_t>(y);
+    if (raw[start] != '\0') throw std::runtime_error("a row filter other than 0");
+    image.rgb.insert(image.rgb.end(), raw.begin() + static_cast<long>(start + 1),
+                     raw.begin() + static_cast<long>(start + 1 + row));
+  }
+  return image;
+}
+
+//! Decodes a PNG file written by leeway.
+inline Image read_png(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return decode_png(std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
+}
+
+}  // namespace leeway::test

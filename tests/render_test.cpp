@@ -1,0 +1,185 @@
+// render.hpp: PNG encoding, the camera model, height colours, ghosts and an offscreen render of a
+// one-link cell with one volume box, checked against hand-worked values.
+#include "leeway/render.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "leeway/error.hpp"
+#include "png_util.hpp"
+#include "test_util.hpp"
+
+namespace leeway {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+TEST(PngTest, EncodesHeaderChunksAndPixels) {
+  Image image;
+  image.width = 3;
+  image.height = 2;
+  // Row 0: red, green, blue; row 1: black, white, (1, 2, 3).
+  image.rgb = {255, 0, 0, 0, 255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 1, 2, 3};
+  const std::string png = encode_png(image);
+  ASSERT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  // IHDR: length 13, "IHDR", width 3, height 2, 8 bits, colour type 2 (RGB), deflate, filter, no interlace.
+  EXPECT_EQ(png.substr(8, 8), std::string("\x00\x00\x00\x0dIHDR", 8));
+  EXPECT_EQ(png.substr(16, 13), std::string("\x00\x00\x00\x03\x00\x00\x00\x02\x08\x02\x00\x00\x00", 13));
+  // The file ends with the empty IEND chunk, whose CRC is the constant AE 42 60 82.
+  EXPECT_EQ(png.substr(png.size() - 12), std::string("\x00\x00\x00\x00IEND\xae\x42\x60\x82", 12));
+  const Image back = test::decode_png(png);
+  EXPECT_EQ(back.width, 3);
+  EXPECT_EQ(back.height, 2);
+  EXPECT_EQ(back.rgb, image.rgb);
+  EXPECT_EQ(back.at(2, 1), (std::array<unsigned char, 3>{1, 2, 3}));
+  // Deterministic bytes.
+  EXPECT_EQ(encode_png(image), png);
+}
+
+TEST(PngTest, SizeOfAWrittenFileAndOfANonPng) {
+  test::TempDir dir;
+  Image image;
+  image.width = 40;
+  image.height = 17;
+  image.rgb.assign(3 * 40 * 17, 128);
+  const std::string path = (dir.path() / "a.png").string();
+  write_png(path, image);
+  EXPECT_EQ(png_size(path), (std::array<int, 2>{40, 17}));
+  const std::string text = dir.write("b.png", "not a png at all, just some text");
+  EXPECT_THROW(png_size(text), InputError);
+}
+
+TEST(ProjectTest, HandWorkedPinhole) {
+  // Looking along +x from (-10, 0, 0): right is -y, up is +z. A 90 degree vertical field of view on
+  // a 200 x 100 image has a focal length of 50 pixels.
+  RenderCamera c;
+  c.azimuth = 0;
+  c.elevation = 0;
+  c.distance = 10;
+  c.lookat = Eigen::Vector3d::Zero();
+  Eigen::Vector2d px;
+  ASSERT_TRUE(project_point(c, kPi / 2, 200, 100, {0, 0, 0}, px));
+  EXPECT_NEAR(px.x(), 100, 1e-9);
+  EXPECT_NEAR(px.y(), 50, 1e-9);
+  ASSERT_TRUE(project_point(c, kPi / 2, 200, 100, {0, -1, 0}, px));  // 1 m right at 10 m: 5 pixels
+  EXPECT_NEAR(px.x(), 105, 1e-9);
+  EXPECT_NEAR(px.y(), 50, 1e-9);
+  ASSERT_TRUE(project_point(c, kPi / 2, 200, 100, {0, 0, 1}, px));  // 1 m up: 5 pixels up
+  EXPECT_NEAR(px.x(), 100, 1e-9);
+  EXPECT_NEAR(px.y(), 45, 1e-9);
+  EXPECT_FALSE(project_point(c, kPi / 2, 200, 100, {-20, 0, 0}, px));  // behind the camera
+  // Straight down from (0, 0, 10) at azimuth 0: the image's up is +x and its right is -y.
+  c.elevation = -kPi / 2;
+  ASSERT_TRUE(project_point(c, kPi / 2, 200, 100, {1, 0, 0}, px));
+  EXPECT_NEAR(px.x(), 100, 1e-9);
+  EXPECT_NEAR(px.y(), 45, 1e-9);
+  ASSERT_TRUE(project_point(c, kPi / 2, 200, 100, {0, 1, 0}, px));
+  EXPECT_NEAR(px.x(), 95, 1e-9);
+  EXPECT_NEAR(px.y(), 50, 1e-9);
+}
+
+TEST(FrameTest, SphereOfTheCylinderFitsTheFieldOfView) {
+  // Radius 3 m, height 8 m: bounding sphere radius 5 m around (1, 2, 4); with a 60 degree field of
+  // view, distance = 1.05 * 5 / sin(30 degrees) = 10.5 m.
+  const RenderCamera c = frame_circle({1, 2}, 3, 8, kPi / 3);
+  EXPECT_NEAR(c.distance, 10.5, 1e-12);
+  EXPECT_EQ(c.lookat, Eigen::Vector3d(1, 2, 4));
+}
+
+TEST(HeightColourTest, ScaleEndsAndMiddle) {
+  const auto low = height_colour(0, 2), mid = height_colour(1, 2), high = height_colour(2, 2);
+  EXPECT_FLOAT_EQ(low[0], 0.267f);
+  EXPECT_FLOAT_EQ(low[2], 0.329f);
+  EXPECT_FLOAT_EQ(mid[1], 0.567f);
+  EXPECT_FLOAT_EQ(high[0], 0.993f);
+  EXPECT_FLOAT_EQ(high[2], 0.144f);
+  EXPECT_EQ(height_colour(5, 2), high);  // clamped
+  EXPECT_EQ(height_colour(1, 0), low);   // no height range
+}
+
+TEST(GhostTest, CornersAndJoints) {
+  const WaypointBounds w(Eigen::Vector2d(0, 0.5), Eigen::Vector2d(-1, 0.5), Eigen::Vector2d(1, 0.7));
+  EXPECT_TRUE(ghost_configurations(w, GhostMode::kNone).empty());
+  const auto corners = ghost_configurations(w, GhostMode::kCorners);
+  ASSERT_EQ(corners.size(), 2u);
+  EXPECT_EQ(corners[0], Eigen::Vector2d(-1, 0.5));
+  EXPECT_EQ(corners[1], Eigen::Vector2d(1, 0.7));
+  // Joint 0 at -1 and at 1; joint 1 only at 0.7 (its lower bound is the nominal value).
+  const auto joints = ghost_configurations(w, GhostMode::kJoints);
+  ASSERT_EQ(joints.size(), 3u);
+  EXPECT_EQ(joints[0], Eigen::Vector2d(-1, 0.5));
+  EXPECT_EQ(joints[1], Eigen::Vector2d(1, 0.5));
+  EXPECT_EQ(joints[2], Eigen::Vector2d(0, 0.7));
+}
+
+class RenderTest : public test::MujocoTest {
+ protected:
+  Scene scene() {
+    return Scene::load(dir_.write("one_link.xml", test::one_link_cell("", R"(<key name="home" qpos="0"/>)")));
+  }
+  test::TempDir dir_;
+};
+
+TEST_F(RenderTest, VolumeBoxColoursThePixelItProjectsTo) {
+  const Scene s = scene();
+  RenderRequest r;
+  r.width = 160;
+  r.height = 120;
+  r.q = Eigen::VectorXd::Zero(1);
+  r.camera.azimuth = 0;
+  r.camera.elevation = -1.5;
+  r.camera.distance = 8;
+  r.camera.lookat = Eigen::Vector3d::Zero();
+  Box box;
+  box.center = {-1.5, 1.5, 0.25};  // away from the arm, which lies along +x
+  box.half_size = {0.4, 0.4, 0.25};
+  const Image off = render_scene(s, r);
+  r.volume = {box};
+  const Image on = render_scene(s, r);
+  ASSERT_EQ(on.width, 160);
+  ASSERT_EQ(on.height, 120);
+  Eigen::Vector2d px;
+  const double fovy = s.model().vis.global.fovy * kPi / 180;
+  ASSERT_TRUE(project_point(r.camera, fovy, r.width, r.height, {-1.5, 1.5, 0.5}, px));
+  const int x = static_cast<int>(px.x()), y = static_cast<int>(px.y());
+  ASSERT_TRUE(x >= 0 && x < 160 && y >= 0 && y < 120) << x << " " << y;
+  // The only box is the highest: yellow (0.993, 0.906, 0.144) at 30 % over the grey floor, so red
+  // clearly exceeds blue there; without the volume the floor is grey (red equals blue).
+  const auto a = on.at(x, y), b = off.at(x, y);
+  EXPECT_GT(int{a[0]} - int{a[2]}, 40) << int{a[0]} << " " << int{a[1]} << " " << int{a[2]};
+  EXPECT_LT(std::abs(int{b[0]} - int{b[2]}), 12) << int{b[0]} << " " << int{b[1]} << " " << int{b[2]};
+  // Far from the box the two renders agree.
+  ASSERT_TRUE(project_point(r.camera, fovy, r.width, r.height, {-1.5, -1.5, 0}, px));
+  const auto c = on.at(static_cast<int>(px.x()), static_cast<int>(px.y()));
+  const auto d = off.at(static_cast<int>(px.x()), static_cast<int>(px.y()));
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(c[static_cast<size_t>(k)], d[static_cast<size_t>(k)], 2);
+}
+
+TEST_F(RenderTest, BadSizesCamerasAndConfigurations) {
+  const Scene s = scene();
+  RenderRequest r;
+  r.q = Eigen::VectorXd::Zero(1);
+  r.width = 8;
+  EXPECT_THROW(render_scene(s, r), InputError);
+  r.width = 64;
+  r.height = 9000;
+  EXPECT_THROW(render_scene(s, r), InputError);
+  r.height = 64;
+  r.camera.distance = std::nan("");
+  EXPECT_THROW(render_scene(s, r), InputError);
+  r.camera.distance = 0;
+  EXPECT_THROW(render_scene(s, r), InputError);
+  r.camera.distance = 5;
+  r.camera.elevation = 2;
+  EXPECT_THROW(render_scene(s, r), InputError);
+  r.camera.elevation = -0.5;
+  r.q = Eigen::VectorXd::Constant(1, std::nan(""));
+  EXPECT_THROW(render_scene(s, r), InputError);
+  r.q = Eigen::VectorXd::Zero(2);
+  EXPECT_THROW(render_scene(s, r), InputError);
+}
+
+}  // namespace
+}  // namespace leeway

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Regenerates the pictures in docs/ (issue 11), from the repository root's build:
+#   - docs/images/dallara-home-patch-volume.png: `leeway render` of the Dallara cell at the patch with
+#     its volume and the ghosts of the robot at its bounds (the README's first picture);
+#   - docs/images/dallara-home-patch-bounds.svg: `leeway plot` of the same bounds file;
+#   - docs/images/sweep-CELL-PATH.svg: `leeway plot` of the nine recorded sweeps in
+#     docs/data/results/ (both configurations) beside the thesis's tables 4.1-4.9;
+# then docs/results.md from the recorded sweeps (tools/make_results.py --render-only), which embeds
+# the sweep plots. The bounds file behind the first two is kept in docs/data/figures/. Deterministic
+# except for the times recorded in that bounds file. Takes a few seconds.
+# Usage: tools/make_figures.sh [path/to/leeway]   (default: build/leeway)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+leeway="${1:-build/leeway}"
+mkdir -p docs/images docs/data/figures
+
+cell=mjcf/workcells/dallara.xml
+bounds=docs/data/figures/dallara-home-patch.json
+"$leeway" bounds "$cell" --from home --to patch --out "$bounds" > /dev/null
+"$leeway" render "$cell" --bounds "$bounds" --size 960x720 --out docs/images/dallara-home-patch-volume.png
+"$leeway" plot "$bounds" --out docs/images/dallara-home-patch-bounds.svg
+
+for case in dallara/home-patch dallara/patch-mould dallara/mould-home \
+            baltico/home-patch baltico/patch-mould baltico/mould-home \
+            dlr/home-patch dlr/patch-mould dlr/mould-home; do
+  name="${case/\//-}"
+  "$leeway" plot "docs/data/results/$name-thesis.csv" "docs/data/results/$name-margin.csv" --thesis "$case" \
+    --out "docs/images/sweep-$name.svg"
+done
+
+python3 tools/make_results.py --render-only

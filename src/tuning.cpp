@@ -97,7 +97,7 @@ std::vector<TunedVariable> tuned_variables() {
       {"alpha_t", 0.25, 4.0, 1.0, "-"},
       {"alpha_g", 0.25, 4.0, 1.0, "-"},
       {"alpha_ng", 0.25, 4.0, 1.0, "-"},
-      {"log10_max_cells", 2.0, std::log10(20000.0), std::log10(20000.0), "log10 cells"},
+      {"log10_max_cells", 2.0, 5.0, std::log10(20000.0), "log10 cells"},
       {"trail_margin", 0.0, 0.3, 0.0, "m"},
   };
 }

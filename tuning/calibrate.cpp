@@ -18,7 +18,7 @@ constexpr int kCalibrationRandomPoints = 24;
 // search box spread over the cases, so that checks, boxes and cells vary independently.
 bool calibrate(Problem& pb) {
   const double lo = pb.lower(kCellsIndex);
-  const double hi = std::min(pb.upper(kCellsIndex), std::log10(20000.0));
+  const double hi = pb.upper(kCellsIndex);
   std::vector<std::pair<size_t, std::vector<double>>> points;
   for (int m = 0; m < 5; ++m) {
     std::vector<double> x = pb.start;

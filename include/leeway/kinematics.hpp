@@ -34,7 +34,8 @@ struct Clearance {
   int obstacle_geom = -1;
 };
 
-//! Forward kinematics and collision queries for one thread.
+//! Forward kinematics and collision queries for one thread (it owns one mjData). Keeps a pointer to
+//! the Scene, which must outlive it.
 class RobotState {
  public:
   explicit RobotState(const Scene& scene);

@@ -35,7 +35,8 @@ CaseSpec parse_case(const std::string& text);
 
 //! A case loaded and ready to evaluate: the scene, the joint-linear path between the keyframes, the
 //! cell's parameters (defaults, the cell's MJCF custom numerics, then the user's base file) and one
-//! volume pool reused by every evaluation (building it costs ~60 ms per cell).
+//! volume pool reused by every evaluation. Owns its Scene and VolumeModel (the model points into the
+//! scene; both live as long as the case).
 class TuningCase {
  public:
   //! Loads the cell and the path. `base_json` (null for none) is applied on top of the cell's

@@ -108,11 +108,11 @@ double near_pairs(const Scene& scene, const std::vector<Eigen::VectorXd>& config
                   const std::vector<Box>& boxes);
 
 //! Deterministic cost proxy of one single-threaded compute_bounds run [ms]: a fixed cost, a cost per
-//! collision check, per check and box (MuJoCo's collision loop visits every active box for every
-//! link geom) and per check and near pair (near_pairs at the path's waypoints: the box-box tests).
-//! The volume generation (about 0.1 us per cell) is left out: it is a few per cent of the bounds at
-//! any size, and as a term of its own it is collinear with the box count. Fitted to measured times
-//! once per process (fit_time_model); docs/tuning.md, "Noise".
+//! collision check, per check and box (with MuJoCo's full pass every check visits every active box;
+//! with the midphase the term carries the volume's generation and injection, linear in the boxes)
+//! and per check and near pair (near_pairs at the path's waypoints: the box-box tests). No per-cell
+//! term: it is collinear with the box count. Fitted to measured times once per process
+//! (fit_time_model); docs/tuning.md, "Noise".
 struct TimeModel {
   double ms_fixed = 0;           //!< per run: categorisation, the checker's data for the whole pool
   double ms_per_check = 0;       //!< kinematics and the copy into the pool model

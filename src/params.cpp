@@ -223,7 +223,10 @@ Params preset_params(const std::string& name) {
     return p;
   }
   if (name == "leeway") {
-    // docs/data/tuning/tuned.json: leeway-tune's result for the nine thesis paths (docs/tuning.md).
+    // docs/data/tuning/preset.json: leeway-tune's run of 2026-11-22 on the nine thesis paths
+    // (MAX_cells up to 20,000, MuJoCo's full collision pass). Later runs (docs/tuning.md,
+    // docs/data/tuning/tuned.json) are reported, not adopted: changing the preset changes every
+    // default output, and is a decision of its own.
     p.height_map.max_cells = 1725;
     p.volume.d_t_lb = 0.3756895344528792;
     p.volume.d_t_ub = 1.77736013400714;

@@ -143,7 +143,7 @@ TEST_F(CliBoundsTest, ParamsPrintsTheCellsDefaults) {
   EXPECT_EQ(j.at("height_map").at("max_cells").get<int>(), 20000);  // section 4.1's table row
   EXPECT_EQ(j.at("volume").at("d_t_lb").get<double>(), 0.35);       // section 4.1: 350 mm
   EXPECT_EQ(j.at("safety").at("mode").get<std::string>(), "none");
-  // The default preset: leeway-tune's parameters (docs/data/tuning/tuned.json), certified.
+  // The default preset: leeway-tune's parameters (docs/data/tuning/preset.json), certified.
   r = run_cli("params");
   ASSERT_EQ(r.exit_code, 0) << r.out;
   j = nlohmann::json::parse(r.out);

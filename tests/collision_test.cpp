@@ -195,6 +195,36 @@ TEST_F(CollisionTest, MidphaseGivesMujocosAnswersOnTheThesisCells) {
   EXPECT_LT(obstacle_hits, checked - 1000);
 }
 
+TEST_F(CollisionTest, MidphaseGivesMujocosAnswersOnACellNotTunedFor) {
+  // shelf_bay (a shelf of thin boards, tables at 0.60 and 1.05 m, a cover panel rotated about two
+  // axes: an obstacle whose AABB is not its box), the leeway preset's volume at 20,000 cells, 3,000
+  // configurations near the pick -> place path and anywhere; volume and obstacles.
+  const Scene scene = Scene::load(test::workcell("shelf_bay"));
+  const auto path = keyframe_path(scene, "pick", "place", 2);
+  Params params = preset_params("leeway");
+  Pair p(test::workcell("shelf_bay"), 20000, path, params);
+  RobotState fast_state(p.fast), reference_state(p.reference);
+  std::mt19937_64 rng(5);
+  const Eigen::VectorXd lo = scene.lower_limits(), hi = scene.upper_limits();
+  long volume_hits = 0, obstacle_hits = 0;
+  for (int s = 0; s < 3000; ++s) {
+    Eigen::VectorXd q = path[0] + detail::unit(rng) * (path[1] - path[0]);
+    const double spread = s % 2 ? 0.4 : 3.0;
+    for (int i = 0; i < q.size(); ++i)
+      q[i] = std::clamp(q[i] + spread * (detail::unit(rng) - 0.5), lo[i], hi[i]);
+    const bool v = p.reference_checker->in_collision(q);
+    ASSERT_EQ(p.fast_checker->in_collision(q), v) << "volume, sample " << s;
+    const bool o = reference_state.in_collision(q);
+    ASSERT_EQ(fast_state.in_collision(q), o) << "obstacles, sample " << s;
+    volume_hits += v;
+    obstacle_hits += o;
+  }
+  EXPECT_GT(volume_hits, 300);
+  EXPECT_LT(volume_hits, 2950);  // the volume fills most of the reach: at least 50 free ones
+  EXPECT_GT(obstacle_hits, 100);
+  EXPECT_LT(obstacle_hits, 2900);
+}
+
 TEST_F(CollisionTest, MidphaseNeverMissesAGrazingContact) {
   // Configurations within 1e-12 rad of the volume's surface (at least 25 brackets; free
   // configurations near the path are rare in the thesis's volume, hence the many attempts): from a free

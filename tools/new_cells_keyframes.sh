@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Derives the goal keyframes of the two cells not used for tuning, mjcf/workcells/press_shop.xml
-# (fixed base: `pick`, `place`) and mjcf/workcells/rail_hall.xml (linear axis: `patch`, `mould`),
+# Derives the goal keyframes of the three cells not used for tuning, mjcf/workcells/press_shop.xml
+# (fixed base: `pick`, `place`), mjcf/workcells/shelf_bay.xml (fixed base: `pick`,
+# `place`) and mjcf/workcells/rail_hall.xml (linear axis: `patch`, `mould`),
 # with leeway's own inverse kinematics, as tools/dlr_keyframes.sh does for DLR: tool0 on the goal
 # site, tool pointing straight down, elbow-up branch (seeded there, j4 = -pi); j6 has no effect on
 # the position or the tool axis, so it keeps its seed, j6 = j1 as in the thesis poses. Fixed base:
@@ -38,6 +39,9 @@ derive() {  # cell key site [--lock rail_x]
 echo "mjcf/workcells/press_shop.xml:"
 derive mjcf/workcells/press_shop.xml pick pick
 derive mjcf/workcells/press_shop.xml place place
+echo "mjcf/workcells/shelf_bay.xml:"
+derive mjcf/workcells/shelf_bay.xml pick pick
+derive mjcf/workcells/shelf_bay.xml place place
 echo "mjcf/workcells/rail_hall.xml:"
 derive mjcf/workcells/rail_hall.xml patch patch rail_x
 derive mjcf/workcells/rail_hall.xml mould mould rail_x

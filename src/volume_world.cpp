@@ -208,7 +208,7 @@ ModelPtr compile_xml(const std::string& xml, const std::string& what) {
 
 }  // namespace
 
-VolumeModel::VolumeModel(const Scene& scene, int capacity) : scene_(&scene) {
+VolumeModel::VolumeModel(const Scene& scene, int capacity, Growth growth) : scene_(&scene), growth_(growth) {
   if (capacity < 1) throw InputError("volume pool capacity " + std::to_string(capacity) + " must be >= 1");
   model_ = compile_xml(pool_xml(scene, 1), scene.source());
   small_ = ModelPtr(mj_copyModel(nullptr, model_.get()));
@@ -229,11 +229,16 @@ void VolumeModel::grow(int capacity) {
   if (capacity <= capacity_) return;
   model_->ngeom = first_pool_geom_ + capacity_;  // the whole pool, as compiled
   model_->body_geomnum[pool_body_] = capacity_;
-  try {
-    model_ = grow_last_body_geoms(*model_, capacity - capacity_);
-  } catch (const std::runtime_error&) {
-    // Another MuJoCo's binary layout: compile the pool from XML instead (quadratic in the pool
-    // size, shared/notes/mujoco-2.2.2.md, but correct).
+  bool grown = false;
+  if (growth_ == Growth::kBinary) try {
+      model_ = grow_last_body_geoms(*model_, capacity - capacity_);
+      grown = true;
+    } catch (const std::runtime_error&) {
+      growth_ = Growth::kXml;  // another MuJoCo's binary layout
+    }
+  if (!grown) {
+    // Compile the pool from XML (quadratic in the pool size, shared/notes/mujoco-2.2.2.md, but it
+    // does not depend on the binary layout).
     model_ = compile_xml(pool_xml(*scene_, capacity), scene_->source());
     pool_body_ = mj_name2id(model_.get(), mjOBJ_BODY, kVolumeBodyName);
   }

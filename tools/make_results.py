@@ -126,6 +126,10 @@ def main():
     safety = ROOT / "docs" / "data" / "safety" / "section.md"
     if safety.exists():
         o.append(safety.read_text())
+    # The fast collision core's benchmark: tools/make_perf_results.py writes this section.
+    perf = ROOT / "docs" / "data" / "perf" / "section.md"
+    if perf.exists():
+        o.append(perf.read_text())
     for cell, src, dst, table in PATHS:
         o.append(f"## {cell.capitalize() if cell != 'dlr' else 'DLR'} {src}-{dst} (thesis table {table})\n")
         plot = f"images/sweep-{cell}-{src}-{dst}.svg"
@@ -151,8 +155,8 @@ def main():
     o.append("## Where the time goes (benchmark)\n")
     o.append("`build/leeway-bench-stages --cell dallara --from A --to B --repeats 5` (one thread, medians; "
              "*us/check* = bounds time per collision check; *kinematics* = the robot's forward kinematics "
-             "on the small model; *mj_collision* = the rest of a check: copying the robot's poses and "
-             "MuJoCo's collision pass over the pool):\n")
+             "on the small model; *collision* = the rest of a check: copying the link poses and the default checker: leeway's midphase, then "
+             "MuJoCo's narrowphase on the volume boxes under the links; the thesis's parameters, no safety stage):\n")
     for src, dst in (("home", "patch"), ("patch", "mould"), ("mould", "home")):
         f = DATA / f"bench-dallara-{src}-{dst}.md"
         if f.exists():

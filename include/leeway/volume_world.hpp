@@ -27,10 +27,13 @@ class VolumeModel {
   //! and sizes, on one free body: their poses are written per check) and a static body
   //! `leeway_volume` holding one template box geom, compiles it, then grows the pool to `capacity`
   //! geoms by rewriting the compiled model through MuJoCo's binary format (MuJoCo's compiler is
-  //! quadratic in the geom count: 21 s for 100,000 geoms, against ~20 ms this way). When the binary
-  //! layout is not the one this code knows (another MuJoCo), the pool is compiled from XML instead.
+  //! quadratic in the geom count: ~20 s for 100,000 geoms, shared/notes/mujoco-2.2.2.md; ~20 ms this
+  //! way). When the binary layout is not the one this code knows (another MuJoCo), the pool is
+  //! compiled from XML instead.
+  //! `growth` kXml forces the XML path (tests compare the two).
   //! @throws InputError when capacity < 1.
-  VolumeModel(const Scene& scene, int capacity);
+  enum class Growth { kBinary, kXml };
+  VolumeModel(const Scene& scene, int capacity, Growth growth = Growth::kBinary);
 
   //! Puts the boxes into the pool (positions, orientations, sizes, bounding radii, bitmasks),
   //! shrinks the pool body's geom count to them so MuJoCo iterates only active boxes, and indexes
@@ -73,6 +76,7 @@ class VolumeModel {
   StaticGeoms pool_;
   ModelPtr small_;
   std::vector<mjtNum> pool_xpos_, pool_xmat_;
+  Growth growth_ = Growth::kBinary;
 };
 
 //! Grows a compiled model's last body's geoms by replicating its last geom `extra` times, through

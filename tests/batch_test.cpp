@@ -161,6 +161,19 @@ TEST(XmlEscapeTest, EscapesTheFiveCharactersAndDropsControlCharacters) {
   EXPECT_EQ(xml_escape(std::string("x\x01y\nz")), "x?y\nz");
 }
 
+// The suite of the nine thesis paths that ships in suites/ is valid.
+TEST(ThesisSuiteTest, ReadsAndValidatesItsNineScenarios) {
+  install_mujoco_error_handlers();
+  const Suite suite = read_suite(std::string(LEEWAY_MJCF_DIR) + "/../suites/thesis.json");
+  EXPECT_EQ(suite.name, "thesis");
+  ASSERT_EQ(suite.scenarios.size(), 9u);
+  for (const auto& s : suite.scenarios) {
+    EXPECT_EQ(s.expect.check, true) << s.name;
+    EXPECT_EQ(s.expect.certified, true) << s.name;
+    EXPECT_TRUE(s.expect.cf_min && s.expect.mean_width_min && s.expect.time_max) << s.name;
+  }
+}
+
 // ------------------------------------------------------------------ the suites
 
 // The one-link cell of the tuning tests: keyframes a and b, a table under the tool at b.
@@ -255,7 +268,7 @@ TEST_F(BatchTest, PassingFailingAndErroringScenariosGiveExitOneAndTheirJUnitTest
 }
 
 TEST_F(BatchTest, ASuiteWhoseExpectationsAllHoldExitsZero) {
-  const auto r = test::run_cli("batch " + suite({passing()}) + " --threads 1");
+  const auto r = test::run_cli("batch " + suite(json::array({passing()})) + " --threads 1");
   EXPECT_EQ(r.exit_code, 0) << r.out;
   EXPECT_THAT(r.out, HasSubstr("1 passed, 0 failed, 0 errors"));
 }

@@ -52,6 +52,10 @@ class Fields {
   [[noreturn]] void fail(const std::string& field, const std::string& what) const {
     throw InputError(where_ + ": field '" + field + "' " + what);
   }
+  //! A library's message about the field's value (it names the file and the element).
+  [[noreturn]] void wrap(const std::string& field, const InputError& e) const {
+    throw InputError(where_ + ": field '" + field + "': " + e.what());
+  }
   const json* find(const std::string& dotted) const {
     const json* at = &j_;
     std::string rest = dotted;
@@ -286,7 +290,7 @@ Suite read_suite(const std::string& file) {
     try {
       if (!scene) scene = std::make_shared<const Scene>(Scene::load(cell_file, scene_options_of(s)));
     } catch (const InputError& e) {
-      f.fail("cell", std::string("'") + s["cell"].get<std::string>() + "': " + e.what());
+      f.wrap("cell", e);
     }
     // The names the scenario uses exist in its cell.
     const auto check_end = [&](const char* key) {
@@ -300,7 +304,7 @@ Suite read_suite(const std::string& file) {
         } else
           scene->keyframe(spec);
       } catch (const InputError& e) {
-        f.fail(key, e.what());
+        f.wrap(key, e);
       }
     };
     if (!by_file) {
@@ -311,20 +315,20 @@ Suite read_suite(const std::string& file) {
       try {
         scene->keyframe(s["ik_seed"].get<std::string>());
       } catch (const InputError& e) {
-        f.fail("ik_seed", e.what());
+        f.wrap("ik_seed", e);
       }
     }
     if (by_file) {
       try {
         read_path(run["path"].get<std::string>(), *scene);
       } catch (const InputError& e) {
-        f.fail("path", e.what());
+        f.wrap("path", e);
       }
     }
     try {
       scenario_params(*scene, run);
     } catch (const InputError& e) {
-      f.fail(s.contains("params") ? "params" : "preset", e.what());
+      f.wrap(s.contains("params") ? "params" : "preset", e);
     }
     Scenario sc;
     sc.name = *name;

@@ -281,7 +281,8 @@ TEST_F(BatchTest, ABadSuiteIsExitTwoBeforeAnyScenarioRunsAndWritesNothing) {
     return s;
   };
   const std::vector<std::pair<json, std::string>> bad = {
-      {{passing(), with("to", "nowhere")}, "scenario 2 'second': field 'to' "},
+      {{passing(), with("to", "nowhere")},
+       "scenario 2 'second': field 'to': " + path("cell.xml") + ": no keyframe 'nowhere'"},
       {{passing(), with("expect", {{"cf_mni", 0.9}})},
        "scenario 2 'second': field 'expect.cf_mni' is not a known key"},
       {{passing(), with("expect", {{"cf_min", 1.5}})},
@@ -292,7 +293,7 @@ TEST_F(BatchTest, ABadSuiteIsExitTwoBeforeAnyScenarioRunsAndWritesNothing) {
       {{passing(), with("safety", "maybe")}, "field 'safety' 'maybe' must be one of"},
       {{passing(), with("name", "a<b & \"c\"")}, "field 'name' 'a<b & \"c\"' is used by an earlier scenario"},
       {{passing(), with("path", "missing.json")}, "field 'path' excludes 'from' and 'to'"},
-      {{passing(), with("params", {{"volume", {{"h_max", -1}}}})}, "scenario 2 'second': field 'params'"},
+      {{passing(), with("params", {{"volume", {{"h_max", -1}}}})}, "scenario 2 'second': field 'params': "},
   };
   for (const auto& [scenarios, message] : bad) {
     const auto r =

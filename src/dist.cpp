@@ -2,6 +2,9 @@
 
 #include <cstdlib>
 #include <exception>
+#include <string>
+
+#include "leeway/error.hpp"
 
 namespace leeway::dist {
 
@@ -37,11 +40,13 @@ class SerialPool : public Pool {
 
 Reply run_task(const Handler& handler, const std::string& task) {
   try {
-    return {true, handler(task)};
+    return {true, handler(task), false};
+  } catch (const InputError& e) {
+    return {false, e.what(), true};
   } catch (const std::exception& e) {
-    return {false, e.what()};
+    return {false, e.what(), false};
   } catch (...) {
-    return {false, "unknown exception"};
+    return {false, "unknown exception", false};
   }
 }
 
@@ -56,6 +61,12 @@ bool built_with_mpi() {
 std::unique_ptr<Pool> make_pool(Handler handler) {
 #ifdef LEEWAY_WITH_MPI
   if (auto pool = make_mpi_pool(handler)) return pool;
+#else
+  for (const char* var : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"})
+    if (const char* n = std::getenv(var); n && std::atoi(n) > 1)
+      throw InputError(std::string("this program was started as one of ") + n +
+                       " MPI ranks but built without MPI (LEEWAY_WITH_MPI off): each rank would run "
+                       "everything; run it without mpirun, or build it with MPI (docs/batch.md)");
 #endif
   return std::make_unique<SerialPool>(std::move(handler));
 }

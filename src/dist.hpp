@@ -16,7 +16,8 @@ namespace leeway::dist {
 //! What one task returned: its text, or the message of the exception it threw.
 struct Reply {
   bool ok = true;
-  std::string text;  //!< the handler's result, or the exception's message when !ok
+  std::string text;        //!< the handler's result, or the exception's message when !ok
+  bool bad_input = false;  //!< the exception was an InputError
 };
 
 //! Runs one task; the same function on every rank.
@@ -43,8 +44,10 @@ class Pool {
 };
 
 //! The MPI pool when leeway was built with MPI and this process was started by an MPI launcher
-//! (mpirun, srun) with more than one rank; otherwise the serial pool. `handler` runs the tasks.
-//! Call it once per process.
+//! (OpenMPI's, PMI or PMIx environment variables); otherwise the serial pool. `handler` runs the
+//! tasks. Call it once per process.
+//! @throws InputError when an MPI launcher started 2+ ranks of a build without MPI (each would
+//! run everything on its own).
 std::unique_ptr<Pool> make_pool(Handler handler);
 
 //! Whether this build can spread work over MPI ranks.

@@ -20,7 +20,7 @@ namespace leeway::dist {
 namespace {
 
 constexpr int kTagTask = 1;   // rank 0 -> worker: 8-byte index, then the task's text
-constexpr int kTagReply = 2;  // worker -> rank 0: 8-byte index, 1 byte ok, then the reply's text
+constexpr int kTagReply = 2;  // worker -> rank 0: 8-byte index, 1 byte (1 ok, 0 failed, 2 bad input), text
 constexpr int kTagStop = 3;   // rank 0 -> worker: no more tasks
 
 // Sleeps between polls: from 20 us, doubling up to 2 ms, back to 20 us when something happened.
@@ -136,7 +136,7 @@ class MpiPool : public Pool {
         const uint64_t i = index_of(m);
         if (i >= tasks.size() || m.size() < sizeof i + 1)
           throw std::runtime_error("MPI pool: a malformed reply");
-        replies[i] = {m[sizeof i] != 0, m.substr(sizeof i + 1)};
+        replies[i] = {m[sizeof i] == 1, m.substr(sizeof i + 1), m[sizeof i] == 2};
         ++done;
         if (on_done) on_done(i, replies[i], st.MPI_SOURCE);
         if (next < tasks.size()) hand_out(st.MPI_SOURCE);
@@ -172,7 +172,7 @@ class MpiPool : public Pool {
       if (st.MPI_TAG == kTagStop) return;
       const uint64_t i = index_of(m);
       const Reply r = run_task(handler_, m.substr(sizeof i));
-      send(pack(i, r.text, r.ok ? 1 : 0), 0, kTagReply);
+      send(pack(i, r.text, r.ok ? 1 : r.bad_input ? 2 : 0), 0, kTagReply);
     }
   }
 

@@ -80,8 +80,8 @@ std::vector<CaseEval> evaluate_cases(Problem& pb, const std::vector<double>& x) 
   const auto replies = pb.pool->map(tasks, {});
   std::vector<CaseEval> evals;
   for (size_t k = 0; k < replies.size(); ++k) {
-    if (!replies[k].ok)
-      throw std::runtime_error("case " + pb.labels[k] + " failed on its rank: " + replies[k].text);
+    if (!replies[k].ok && replies[k].bad_input) throw InputError(replies[k].text);
+    if (!replies[k].ok) throw std::runtime_error("case " + pb.labels[k] + ": " + replies[k].text);
     evals.push_back(eval_from_json(json::parse(replies[k].text)));
   }
   return evals;

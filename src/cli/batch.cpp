@@ -1,6 +1,7 @@
 #include "cli/batch.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -56,6 +57,7 @@ CLI::App* add_batch(CLI::App& app, BatchArgs& args) {
 }
 
 int run_batch(const BatchArgs& args) {
+  const auto t0 = std::chrono::steady_clock::now();
   int threads = args.threads;
   auto pool = dist::make_pool(
       [&threads](const std::string& task) { return run_scenario(json::parse(task), threads).dump(); });
@@ -138,7 +140,11 @@ int run_batch(const BatchArgs& args) {
             << (errors == 1 ? "" : "s") << ", " << warnings << " time warning" << (warnings == 1 ? "" : "s")
             << "\n";
   if (!args.out.empty()) {
-    write_file_atomic(args.out, suite_results_json(suite, results).dump(2) + "\n");
+    json all = suite_results_json(suite, results);
+    all["timing"]["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    all["timing"]["ranks"] = pool->size();
+    all["timing"]["threads"] = threads;
+    write_file_atomic(args.out, all.dump(2) + "\n");
     std::cout << "wrote " << args.out << "\n";
   }
   if (!args.junit.empty()) {

@@ -121,10 +121,13 @@ class Fields {
 void check_fields(const Fields& f, const json& s, bool is_defaults) {
   f.known_keys(s, "", kScenarioKeys);
   if (is_defaults && s.contains("name")) f.fail("name", "belongs to each scenario, not to the defaults");
-  for (const char* key : {"name", "cell", "from", "to", "path", "ik_seed", "params"})
-    if (std::string(key) != "params" || !s.contains("params") || !s["params"].is_object()) f.text(key);
-  if (s.contains("params") && !s["params"].is_object() && !s["params"].is_string())
-    f.fail("params", "must be a parameter file's name or an object of parameters, not " + s["params"].dump());
+  for (const char* key : {"name", "cell", "from", "to", "path", "ik_seed"}) f.text(key);
+  if (s.contains("params") && !s["params"].is_object()) {
+    if (!s["params"].is_string())
+      f.fail("params",
+             "must be a parameter file's name or an object of parameters, not " + s["params"].dump());
+    f.text("params");
+  }
   f.whole("waypoints", 2, 100000);
   f.one_of("preset", {"leeway", "thesis"});
   f.whole("max_cells", 1, kMaxCellsLimit);

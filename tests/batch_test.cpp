@@ -294,6 +294,7 @@ TEST_F(BatchTest, ABadSuiteIsExitTwoBeforeAnyScenarioRunsAndWritesNothing) {
       {{passing(), with("name", "a<b & \"c\"")}, "field 'name' 'a<b & \"c\"' is used by an earlier scenario"},
       {{passing(), with("path", "missing.json")}, "field 'path' excludes 'from' and 'to'"},
       {{passing(), with("params", {{"volume", {{"h_max", -1}}}})}, "scenario 2 'second': field 'params': "},
+      {{passing(), with("params", 7)}, "field 'params' must be a parameter file's name or an object"},
   };
   for (const auto& [scenarios, message] : bad) {
     const auto r =

@@ -87,7 +87,13 @@ def main():
     print("per-scenario times [s]: " + ", ".join(f"{t:.2f}" for t in times))
     print("projected makespan [s] (ratio to 1 rank): " +
           ", ".join(f"{p} ranks {m:.2f} ({m / projected[1]:.2f})" for p, m in projected.items()))
-    data = {"command": "tools/batch_scaling.py " + " ".join(f"--{k} {v}" for k, v in vars(a).items()),
+    def shown(v):
+        try:
+            return str(pathlib.Path(v).resolve().relative_to(ROOT))
+        except (ValueError, TypeError):
+            return str(v)
+
+    data = {"command": "tools/batch_scaling.py " + " ".join(f"--{k} {shown(v)}" for k, v in vars(a).items()),
             "machine": machine(), "cores": os.cpu_count(), "runs": rows, "median_wall_s": {"1": one, "2": two},
             "ratio": two / one, "scenario_seconds": times,
             "projected_makespan_s": {str(p): m for p, m in projected.items()}}

@@ -305,6 +305,11 @@ TEST_F(BatchTest, ABadSuiteIsExitTwoBeforeAnyScenarioRunsAndWritesNothing) {
     EXPECT_FALSE(std::filesystem::exists(path("r.xml")));
     EXPECT_FALSE(std::filesystem::exists(path("r.json")));
   }
+  // The output files are checked before anything runs too.
+  const auto txt = test::run_cli("batch " + suite(json::array({passing()})) + " --junit " + path("r.txt"));
+  EXPECT_EQ(txt.exit_code, 2) << txt.out;
+  EXPECT_THAT(txt.out, HasSubstr("--junit " + path("r.txt") + ": the file name must end in .xml"));
+  EXPECT_THAT(txt.out, Not(HasSubstr("[1/")));
   // The top level too.
   const std::string no_format = dir_.write("f.json", R"({"scenarios": []})");
   const auto r = test::run_cli("batch " + no_format);
@@ -368,6 +373,8 @@ TEST_F(BatchTest, LeewayTuneOnTwoMpiRanksSearchesAsOneProcess) {
   ASSERT_EQ(one.exit_code, 0) << one.out;
   const auto two = test::run_program(mpirun() + tune, args("two"));
   ASSERT_EQ(two.exit_code, 0) << two.out;
+  EXPECT_THAT(two.out, HasSubstr("cases spread over 2 MPI ranks"));
+  EXPECT_THAT(one.out, Not(HasSubstr("MPI ranks")));
   EXPECT_EQ(read_text(path("one.json")), read_text(path("two.json")));
   // The log row by row: the variables, CF, widths and objective (not the measured times).
   const auto columns = [&](const std::string& tag) {

@@ -139,6 +139,9 @@ std::optional<SearchResult> search(Problem& pb, std::ostream* log, double t0) {
   std::cerr << "tuning " << pb.cases.size() << " case(s) with " << o.algorithm << ": J = 100 CF - "
             << num(objective.lambda) << " T[s] - " << num(objective.mu) << " S (min width "
             << num(objective.min_width) << " rad), " << o.aggregate << " over the cases, time " << o.time
+            << (pb.pool && pb.pool->size() > 1
+                    ? "; cases spread over " + std::to_string(pb.pool->size()) + " MPI ranks"
+                    : std::string())
             << "\n";
   const auto outcome = leeway::tune::search(space, settings, evaluate, interrupted, on_record);
   const double search_s = now_s() - t0;

@@ -235,6 +235,7 @@ std::string xml_escape(const std::string& text) {
 
 Suite read_suite(const std::string& file) {
   const json j = detail::read_json_file(file, "suite");
+  if (!j.is_object()) throw InputError(file + ": a suite is a JSON object with \"format\" and \"scenarios\"");
   Fields top(j, file);
   top.known_keys(j, "", {"format", "name", "defaults", "scenarios"});
   if (j.value("format", json()) != kSuiteFormat)

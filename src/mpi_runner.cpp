@@ -67,6 +67,10 @@ uint64_t index_of(const std::string& m) {
 class MpiPool : public Pool {
  public:
   explicit MpiPool(Handler handler) : handler_(std::move(handler)) {
+    // OpenMPI's shared-memory transport copies large messages between processes with
+    // process_vm_readv, which containers often forbid (each such message then fails). Replies are
+    // kilobytes: the plain copy costs nothing. A value the user set is kept.
+    ::setenv("OMPI_MCA_btl_vader_single_copy_mechanism", "none", 0);
     int provided = 0;
     MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
     if (provided < MPI_THREAD_FUNNELED) {

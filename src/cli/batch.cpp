@@ -1,5 +1,7 @@
 #include "cli/batch.hpp"
 
+#include <sched.h>
+
 #include <algorithm>
 #include <chrono>
 #include <iomanip>
@@ -40,6 +42,15 @@ std::string outcome(const json& r) {
   return s;
 }
 
+// The cores divided among this machine's ranks, and no more than this process may run on: mpirun
+// binds each of 2 ranks to one core by default, and its threads would share that core.
+int default_batch_threads(int local_ranks) {
+  int cores = static_cast<int>(std::thread::hardware_concurrency()) / std::max(1, local_ranks);
+  cpu_set_t mask;
+  if (::sched_getaffinity(0, sizeof mask, &mask) == 0) cores = std::min(cores, CPU_COUNT(&mask));
+  return std::max(1, cores);
+}
+
 }  // namespace
 
 CLI::App* add_batch(CLI::App& app, BatchArgs& args) {
@@ -61,9 +72,7 @@ int run_batch(const BatchArgs& args) {
   int threads = args.threads;
   auto pool = dist::make_pool(
       [&threads](const std::string& task) { return run_scenario(json::parse(task), threads).dump(); });
-  if (threads == 0)
-    threads =
-        std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / std::max(1, pool->local_size()));
+  if (threads == 0) threads = default_batch_threads(pool->local_size());
   if (pool->rank() != 0) {
     pool->serve();
     return kExitOk;

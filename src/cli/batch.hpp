@@ -14,7 +14,8 @@ struct BatchArgs {
   std::string suite;  //!< the suite file (JSON)
   std::string junit;  //!< JUnit XML report to write; empty: none
   std::string out;    //!< results JSON to write; empty: none
-  int threads = 0;    //!< worker threads per scenario; 0: the cores divided among this machine's ranks
+  int threads = 0;    //!< worker threads per scenario; 0: this machine's cores divided among its ranks,
+                      //!< at most the cores this process is bound to
 };
 
 //! Adds the `batch` subcommand, parsing into `args`; returns it.

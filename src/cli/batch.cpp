@@ -77,7 +77,8 @@ int run_batch(const BatchArgs& args) {
     pool->serve();
     return kExitOk;
   }
-  if (args.threads < 0) throw InputError("--threads " + std::to_string(args.threads) + " must be >= 1");
+  if (args.threads < 0)
+    throw InputError("--threads " + std::to_string(args.threads) + " must be >= 1 (or 0: the default)");
   // Everything is checked before the first scenario runs.
   const Suite suite = read_suite(args.suite);
   if (!args.junit.empty()) require_output(args.junit, "--junit", {".xml"});

@@ -3,14 +3,15 @@
 # Idempotent and non-interactive; when everything is installed it only asks dpkg and returns.
 # libqhull-dev: Debian's mujoco::mujoco target names /usr/include/libqhull_r as an include path.
 # libosmesa6-dev: offscreen OpenGL without a display for `leeway render` and PNG plots (MuJoCo links
-# no GL itself); zlib1g-dev: PNG compression.
+# no GL itself); zlib1g-dev: PNG compression. libopenmpi-dev, openmpi-bin: `leeway batch` and
+# leeway-tune over MPI ranks (optional for the build; the MPI tests run when mpirun is there).
 set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config clang-format python3
   libmujoco-dev libqhull-dev libeigen3-dev libompl-dev libnlopt-cxx-dev liburdfdom-dev
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
-  libosmesa6-dev zlib1g-dev
+  libosmesa6-dev zlib1g-dev libopenmpi-dev openmpi-bin
 )
 
 missing=()

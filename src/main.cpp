@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "cli/batch.hpp"
 #include "cli/bounds.hpp"
 #include "cli/cf.hpp"
 #include "cli/check.hpp"
@@ -45,6 +46,7 @@ int main(int argc, char** argv) {
   NewCellArgs new_cell;
   RenderArgs render;
   PlotArgs plot;
+  BatchArgs batch;
   // In the order of `leeway --help`.
   const std::vector<std::pair<CLI::App*, std::function<int()>>> commands = {
       {add_check(app, check), [&] { return run_check(check); }},
@@ -59,6 +61,7 @@ int main(int argc, char** argv) {
       {add_new_cell(app, new_cell), [&] { return run_new_cell(new_cell); }},
       {add_render(app, render), [&] { return run_render(render); }},
       {add_plot(app, plot), [&] { return run_plot(plot); }},
+      {add_batch(app, batch), [&] { return run_batch(batch); }},
   };
 
   return run_reporting_errors("leeway", [&]() -> int {

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "cli/common.hpp"
+#include "distribute.hpp"
 #include "leeway/error.hpp"
 #include "leeway/mujoco_util.hpp"
 #include "problem.hpp"
@@ -119,6 +120,13 @@ int main(int argc, char** argv) {
     pb.command = "leeway-tune";
     for (int i = 1; i < argc; ++i) pb.command += std::string(" ") + argv[i];
     load(pb);
+    // Under mpirun every rank has loaded the problem; ranks other than 0 evaluate cases for rank 0.
+    const auto pool = leeway::dist::make_pool(case_handler(pb));
+    if (pool->rank() != 0) {
+      pool->serve();
+      return leeway::kExitOk;
+    }
+    pb.pool = pool.get();
     std::ofstream log;
     if (!o.log.empty()) {
       log.open(o.log);

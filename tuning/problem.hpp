@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "dist.hpp"
 #include "leeway/confidence.hpp"
 #include "leeway/error.hpp"
 #include "leeway/file_io.hpp"
@@ -78,6 +79,7 @@ struct Problem {
   std::vector<std::string> labels;
   leeway::TimeModel model;
   json report;
+  dist::Pool* pool = nullptr;  // runs the cases of an evaluation (main.cpp); rank 0 only
 
   size_t size() const { return vars.size(); }
   double lower(size_t i) const { return fixed[i] ? start[i] : vars[i].lower; }

@@ -3,6 +3,7 @@
 #include <iomanip>
 #include <iostream>
 
+#include "distribute.hpp"
 #include "stages.hpp"
 #include "statistics.hpp"
 
@@ -17,12 +18,10 @@ std::optional<SearchResult> search(Problem& pb, std::ostream* log, double t0) {
   auto& details = result.details;  // by canonical variables
   auto& records = result.records;
   auto evaluate = [&](const std::vector<double>& x) -> std::optional<double> {
-    std::vector<CaseEval> evals;
-    for (size_t k = 0; k < pb.cases.size(); ++k) {
-      if (interrupted()) return std::nullopt;
-      evals.push_back(leeway::evaluate_case(*pb.cases[k], pb.params(k, x), o.cf, o.repeats, o.threads,
-                                            pb.model, objective));
-    }
+    if (interrupted()) return std::nullopt;
+    // The cases spread over the ranks of an mpirun (distribute.cpp), in case order.
+    const std::vector<CaseEval> evals = evaluate_cases(pb, x);
+    if (interrupted()) return std::nullopt;
     const double j = leeway::aggregate_score(evals, objective);
     details[pb.canonical(x)] = evals;
     return j;
@@ -140,6 +139,9 @@ std::optional<SearchResult> search(Problem& pb, std::ostream* log, double t0) {
   std::cerr << "tuning " << pb.cases.size() << " case(s) with " << o.algorithm << ": J = 100 CF - "
             << num(objective.lambda) << " T[s] - " << num(objective.mu) << " S (min width "
             << num(objective.min_width) << " rad), " << o.aggregate << " over the cases, time " << o.time
+            << (pb.pool && pb.pool->size() > 1
+                    ? "; cases spread over " + std::to_string(pb.pool->size()) + " MPI ranks"
+                    : std::string())
             << "\n";
   const auto outcome = leeway::tune::search(space, settings, evaluate, interrupted, on_record);
   const double search_s = now_s() - t0;

@@ -293,8 +293,12 @@ TEST_F(CollisionTest, BoxesPlacedAtALinksBottomCornerAgree) {
       reference_world.set_boxes({v});
       const bool r = reference_checker.in_collision(q);
       EXPECT_EQ(fast_checker.in_collision(q), r) << "shape " << shape << " gap " << gap;
-      if (gap == 1e-6) EXPECT_FALSE(r) << "shape " << shape;
-      if (gap == -1e-6 && shape == 0) EXPECT_TRUE(r);  // the corner 1e-6 m inside the box's top
+      if (gap == 1e-6) {
+        EXPECT_FALSE(r) << "shape " << shape;
+      }
+      if (gap == -1e-6 && shape == 0) {
+        EXPECT_TRUE(r);  // the corner 1e-6 m inside the box's top
+      }
       ++agreed;
     }
   EXPECT_EQ(agreed, 15);

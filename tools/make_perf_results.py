@@ -85,7 +85,7 @@ def render(info, repetitions):
     one = us("BM_Bounds/25000") / 1e3
     o += ["", f"Two threads at MAX_cells 25,000: {two:.2f} ms, {two / one:.2f} x the one-thread time (the runs "
           "of each joint level in parallel; at a few milliseconds per run, starting threads for each level "
-          "costs more than it saves on this shared 2-core machine; the parallel runs pay on longer runs such as the certified paths).\n",
+          "costs more than it saves on this shared 2-core machine).\n",
           "### Against the targets of issue 10\n",
           "| target | before (issue 10, main b3f0610) | now |", "|---|---:|---:|",
           f"| bounds, MAX_cells 25,000, one thread: <= 15 ms | ~900 ms | {us('BM_Bounds/25000') / 1e3:.2f} ms |",

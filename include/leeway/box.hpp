@@ -30,8 +30,9 @@ double box_penetration(const Box& a, const Box& b);
 Eigen::Vector3d closest_point(const Box& box, const Eigen::Vector3d& p);
 
 //! Euclidean distance [m] between two oriented boxes (0 when they touch or overlap), with the
-//! closest points when the out-pointers are given. Alternating projections between the two convex
-//! sets, which converge to a closest pair; stopped when a step moves less than 1e-12 m.
+//! closest points when the out-pointers are given. Exact (up to rounding): for disjoint boxes the
+//! smallest of every vertex's distance to the other box and every edge pair's segment distance,
+//! which covers every feature pair a closest pair of two convex polytopes can lie on.
 double box_distance(const Box& a, const Box& b, Eigen::Vector3d* on_a = nullptr,
                     Eigen::Vector3d* on_b = nullptr);
 

@@ -132,7 +132,7 @@ inline CLI::Validator seed_check(std::uint64_t max = std::numeric_limits<std::ui
         if (errno == ERANGE || v > max) return bad;
         return "";
       },
-      "SEED");
+      "");
 }
 
 //! seed_check up to the largest value of the seed's type.
@@ -144,7 +144,7 @@ CLI::Validator seed_check_for(const T&) {
 //! A CLI11 check for a file name: not empty.
 inline CLI::Validator file_name_check() {
   return CLI::Validator(
-      [](std::string& text) -> std::string { return text.empty() ? "the file name is empty" : ""; }, "FILE");
+      [](std::string& text) -> std::string { return text.empty() ? "the file name is empty" : ""; }, "");
 }
 
 //! A CLI11 check for a number: finite (CLI11 accepts "nan" and "inf" for a double).
@@ -157,7 +157,7 @@ inline CLI::Validator finite_check() {
         if (!std::isfinite(v)) return "'" + text + "' is not a finite number";
         return "";
       },
-      "NUMBER");
+      "");
 }
 
 //! Scene options with the given tool site and collision checker ("midphase" or "mujoco").

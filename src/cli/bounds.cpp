@@ -1,5 +1,6 @@
 #include "cli/bounds.hpp"
 
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -107,6 +108,11 @@ int run_bounds(const BoundsArgs& args) {
   if (args.max_cells_given) p.height_map.max_cells = args.max_cells;
   p.validate();
   require_threads(args.threads);
+  const bool mjb = std::filesystem::path(args.cell).extension() == ".mjb";
+  if (mjb && (!args.export_mjcf.empty() || !args.export_mjb.empty()))
+    throw InputError(std::string(args.export_mjcf.empty() ? "--export-mjb" : "--export-mjcf") +
+                     " needs the cell's MJCF text; " + args.cell +
+                     " is a compiled MuJoCo model (.mjb): give the cell's .xml file");
   const std::vector<std::string> inputs = {args.cell, args.params, args.path};
   if (!args.out.empty()) require_output(args.out, "--out", {}, inputs);
   if (!args.export_mjcf.empty()) require_output(args.export_mjcf, "--export-mjcf", {".xml"}, inputs);

@@ -103,16 +103,16 @@ CLI::App* add_bounds(CLI::App& app, BoundsArgs& args) {
 }
 
 int run_bounds(const BoundsArgs& args) {
-  const auto scene = Scene::load(args.cell, scene_options(kDefaultTool, args.checker));
-  Params p = load_params(scene, args.preset, args.params, args.safety);
-  if (args.max_cells_given) p.height_map.max_cells = args.max_cells;
-  p.validate();
-  require_threads(args.threads);
   const bool mjb = std::filesystem::path(args.cell).extension() == ".mjb";
   if (mjb && (!args.export_mjcf.empty() || !args.export_mjb.empty()))
     throw InputError(std::string(args.export_mjcf.empty() ? "--export-mjb" : "--export-mjcf") +
                      " needs the cell's MJCF text; " + args.cell +
                      " is a compiled MuJoCo model (.mjb): give the cell's .xml file");
+  const auto scene = Scene::load(args.cell, scene_options(kDefaultTool, args.checker));
+  Params p = load_params(scene, args.preset, args.params, args.safety);
+  if (args.max_cells_given) p.height_map.max_cells = args.max_cells;
+  p.validate();
+  require_threads(args.threads);
   const std::vector<std::string> inputs = {args.cell, args.params, args.path};
   if (!args.out.empty()) require_output(args.out, "--out", {}, inputs);
   if (!args.export_mjcf.empty()) require_output(args.export_mjcf, "--export-mjcf", {".xml"}, inputs);

@@ -103,8 +103,8 @@ CLI::App* add_bounds(CLI::App& app, BoundsArgs& args) {
 }
 
 int run_bounds(const BoundsArgs& args) {
-  const bool mjb = std::filesystem::path(args.cell).extension() == ".mjb";
-  if (mjb && (!args.export_mjcf.empty() || !args.export_mjb.empty()))
+  const bool cell_is_mjb = std::filesystem::path(args.cell).extension() == ".mjb";
+  if (cell_is_mjb && (!args.export_mjcf.empty() || !args.export_mjb.empty()))
     throw InputError(std::string(args.export_mjcf.empty() ? "--export-mjb" : "--export-mjcf") +
                      " needs the cell's MJCF text; " + args.cell +
                      " is a compiled MuJoCo model (.mjb): give the cell's .xml file");

@@ -3,6 +3,7 @@
 #include <cstdlib>
 #include <iostream>
 
+#include "cli/common.hpp"
 #include "leeway/error.hpp"
 #include "leeway/file_io.hpp"
 #include "leeway/urdf_import.hpp"

@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "cli/common.hpp"
 #include "leeway/error.hpp"
 #include "leeway/new_cell.hpp"
 

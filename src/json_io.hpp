@@ -2,7 +2,6 @@
 // Internal: the JSON helpers shared by the library's readers and writers (not public API).
 
 #include <Eigen/Core>
-#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -27,12 +26,12 @@ inline nlohmann::json to_json_array(const Eigen::VectorXd& v) {
 }
 
 //! Parses JSON text from `source` (a file name, for the messages): nesting deeper than
-//! kMaxJsonDepth, a key given twice in one object and a number outside the double range are refused.
+//! kMaxJsonDepth and a key given twice in one object are refused, as is a number outside the double
+//! range (nlohmann's "number overflow parsing '1e400'").
 //! @throws InputError "SOURCE: malformed JSON: ..." or "SOURCE: ..." naming the key (one line).
 inline nlohmann::json parse_json_text(const std::string& text, const std::string& source) {
   // The parser is iterative; the callback sees every event with its depth before any recursion.
   std::vector<std::set<std::string>> keys;  // the keys seen in each open object
-  std::string path;                         // the last key, for the messages
   auto callback = [&](int depth, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
     using E = nlohmann::json::parse_event_t;
     if (depth > kMaxJsonDepth)
@@ -43,10 +42,7 @@ inline nlohmann::json parse_json_text(const std::string& text, const std::string
       const std::string key = parsed.get<std::string>();
       if (!keys.back().insert(key).second)
         throw InputError(source + ": JSON key '" + key + "' appears twice in one object");
-      path = key;
     }
-    if (event == E::value && parsed.is_number_float() && !std::isfinite(parsed.get<double>()))
-      throw InputError(source + ": the number after key '" + path + "' is outside the range of a double");
     return true;
   };
   try {

@@ -88,16 +88,11 @@ TuningCase::TuningCase(const CaseSpec& spec, const nlohmann::json& base_json, in
 std::vector<TunedVariable> tuned_variables() {
   // Bounds: docs/tuning.md, "Tuned variables". Lengths in metres.
   return {
-      {"d_t_lb", 0.0, 1.5, 0.35, "m"},
-      {"d_t_ub", 0.3, 3.0, 1.5, "m"},
-      {"d_g_lb", 0.0, 1.0, 0.1, "m"},
-      {"d_g_ub", 0.3, 3.0, 2.0, "m"},
-      {"d_ng_ub", 0.05, 1.5, 0.5, "m"},
-      {"h_max", 0.2, 3.0, 1.5, "m"},
-      {"alpha_t", 0.25, 4.0, 1.0, "-"},
-      {"alpha_g", 0.25, 4.0, 1.0, "-"},
-      {"alpha_ng", 0.25, 4.0, 1.0, "-"},
-      {"log10_max_cells", 2.0, 5.0, std::log10(20000.0), "log10 cells"},
+      {"d_t_lb", 0.0, 1.5, 0.35, "m"},      {"d_t_ub", 0.3, 3.0, 1.5, "m"},
+      {"d_g_lb", 0.0, 1.0, 0.1, "m"},       {"d_g_ub", 0.3, 3.0, 2.0, "m"},
+      {"d_ng_ub", 0.05, 1.5, 0.5, "m"},     {"h_max", 0.2, 3.0, 1.5, "m"},
+      {"alpha_t", 0.25, 4.0, 1.0, "-"},     {"alpha_g", 0.25, 4.0, 1.0, "-"},
+      {"alpha_ng", 0.25, 4.0, 1.0, "-"},    {"log10_max_cells", 2.0, 5.0, std::log10(20000.0), "log10 cells"},
       {"trail_margin", 0.0, 0.3, 0.0, "m"},
   };
 }

@@ -18,9 +18,10 @@ void apply_cell_defaults(const Scene& scene, Params& params) {
   };
   double v = 0;
   if (numeric("leeway_reach_radius", v)) {
-    if (v <= 0)
+    if (!(v >= kMinMapSide && v <= kMaxLength))
       throw InputError(scene.source() + ": custom numeric 'leeway_reach_radius' = " + format_number(v) +
-                       " must be > 0 m");
+                       " m must be between " + format_number(kMinMapSide) + " and " +
+                       format_number(kMaxLength) + " m");
     params.volume.reach_radius = v;
   }
   if (numeric("leeway_add_obstacle_boxes", v)) {

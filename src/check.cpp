@@ -5,7 +5,9 @@
 
 #include "json_io.hpp"
 #include "leeway/categorize.hpp"
+#include "leeway/cell_defaults.hpp"
 #include "leeway/error.hpp"
+#include "leeway/pipeline.hpp"
 
 namespace leeway {
 namespace {
@@ -55,6 +57,14 @@ CheckReport check_scene(const Scene& scene, const CheckOptions& options) {
     throw InputError("overlap tolerance '" + format_number(options.overlap_tolerance) + "' must be >= 0 m");
   if (!std::isfinite(options.reach_tolerance) || options.reach_tolerance <= 0)
     throw InputError("reach tolerance '" + format_number(options.reach_tolerance) + "' must be > 0 m");
+  if (!(options.goal_dz >= kMinGoalDz && options.goal_dz <= 10))
+    throw InputError("goal descent step '" + format_number(options.goal_dz) + "' must be between " +
+                     format_number(kMinGoalDz) + " and 10 m");
+  // A cell `bounds` would refuse fails here too: its own parameters (custom numerics) against the
+  // default preset's, and the preset's against its joints.
+  Params cell_params = preset_params("leeway");
+  apply_cell_defaults(scene, cell_params);
+  validate_for_scene(cell_params, scene);
   const mjModel& m = scene.model();
   CheckReport report;
   RobotState state(scene);

@@ -56,8 +56,8 @@ Pose RobotState::site_pose(int site) const {
 Pose RobotState::tool_pose() const { return site_pose(scene_->tool_site()); }
 
 void RobotState::run_collision() {
+  prevent_contact_warnings(*data_);  // a full contact buffer still answers "in collision"
   mj_collision(&scene_->model(), data_.get());
-  take_mujoco_warnings();  // a full contact buffer still answers "in collision"
 }
 
 bool RobotState::in_collision(const Eigen::VectorXd& q) {

@@ -24,11 +24,13 @@
 #include "cli/render.hpp"
 #include "cli/sweep.hpp"
 #include "leeway/error.hpp"
+#include "leeway/file_io.hpp"
 #include "leeway/mujoco_util.hpp"
 
 int main(int argc, char** argv) {
   using namespace leeway::cli;
   leeway::install_mujoco_error_handlers();  // MuJoCo errors become exceptions, not exit()
+  leeway::install_temp_file_cleanup();      // no .NAME.tmpPID left behind by SIGTERM, SIGINT, SIGHUP
   CLI::App app{
       "leeway: collision-free joint intervals around a nominal robot path (SI units: metres, radians)"};
   app.require_subcommand(1);
@@ -78,7 +80,7 @@ int main(int argc, char** argv) {
                 << " (see leeway --help)\n";
       return leeway::kExitBadInput;
     }
-    if (const auto code = parse_cli(app, argc, argv)) return *code;
+    if (const auto code = parse_cli(app, argc, argv, "leeway")) return *code;
     for (const auto& [sub, run] : commands)
       if (*sub) return run();
     return leeway::kExitOk;

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "leeway/error.hpp"
+#include "leeway/file_io.hpp"
 
 namespace leeway {
 namespace {
@@ -19,6 +20,8 @@ void throw_on_error(const char* msg) {
   throw InputError(std::string("MuJoCo error: ") + msg);
 }
 
+// Thread-safe: each thread appends to its own list. MuJoCo formats some warnings in a process-wide
+// buffer before it calls this handler; prevent_contact_warnings keeps those from worker threads.
 void collect_warning(const char* msg) { t_warnings.emplace_back(msg); }
 
 }  // namespace
@@ -35,6 +38,13 @@ std::vector<std::string> take_mujoco_warnings() {
   std::vector<std::string> out;
   out.swap(t_warnings);
   return out;
+}
+
+void prevent_contact_warnings(mjData& d) {
+  // mj_warning formats its text (in a buffer shared by all threads, mju_warningText) only the first
+  // time a warning occurs in an mjData: mark the contact-buffer warnings as already raised.
+  for (int w : {mjWARN_CONTACTFULL, mjWARN_CNSTRFULL})
+    if (d.warning[w].number == 0) d.warning[w].number = 1;
 }
 
 namespace {
@@ -57,6 +67,7 @@ std::string one_line(const char* error) {
 ModelPtr load_model_file(const std::string& path) {
   // Documented in the header: without it a malformed file would make MuJoCo exit() the process.
   install_mujoco_error_handlers();
+  require_regular_input(path, "file");  // a FIFO would block MuJoCo's reader
   std::ifstream probe(path);
   if (!probe.good()) throw InputError(path + ": cannot open the file (missing or unreadable)");
   probe.close();

@@ -159,16 +159,18 @@ void Params::validate() const {
                          " must be a finite number");
     }
   });
+  // Physical bounds: a workcell is metres across; lengths beyond kMaxLength [m] or steps below the
+  // lower bounds would only produce unusable bounds or run for ever (issue 14).
   const HeightMapParams& hm = height_map;
   require_between("height_map.max_cells", hm.max_cells, 1, kMaxCellsLimit);
+  require_between("height_map.origin_x", hm.origin_x, -kMaxLength, kMaxLength);
+  require_between("height_map.origin_y", hm.origin_y, -kMaxLength, kMaxLength);
   if (!hm.auto_extent) {
     // Explicit extents only matter (and are only checked) when auto_extent is off.
-    if (!(hm.x_dim > 0))
-      throw InputError(describe("height_map.x_dim", hm.x_dim) +
-                       " must be > 0 when 'height_map.auto_extent' is false");
-    if (!(hm.y_dim > 0))
-      throw InputError(describe("height_map.y_dim", hm.y_dim) +
-                       " must be > 0 when 'height_map.auto_extent' is false");
+    for (const auto& [key, dim] : {std::pair{"height_map.x_dim", hm.x_dim}, {"height_map.y_dim", hm.y_dim}})
+      if (!(dim >= kMinMapSide && dim <= kMaxLength))
+        throw InputError(describe(key, dim) + " must be between " + value_text(kMinMapSide) + " and " +
+                         value_text(kMaxLength) + " m when 'height_map.auto_extent' is false");
   }
   const VolumeParams& v = volume;
   require_non_negative("volume.d_t_lb", v.d_t_lb);
@@ -182,14 +184,25 @@ void Params::validate() const {
   require_positive("volume.alpha_g", v.alpha_g);
   require_positive("volume.alpha_ng", v.alpha_ng);
   require_positive("volume.reach_radius", v.reach_radius);
+  require_between("volume.reach_radius", v.reach_radius, kMinMapSide, kMaxLength);
+  for (const auto& [key, value] : {std::pair{"volume.d_t_ub", v.d_t_ub},
+                                   {"volume.d_g_ub", v.d_g_ub},
+                                   {"volume.d_ng_ub", v.d_ng_ub},
+                                   {"volume.h_max", v.h_max},
+                                   {"volume.trail_margin", v.trail_margin},
+                                   {"volume.alpha_t", v.alpha_t},
+                                   {"volume.alpha_g", v.alpha_g},
+                                   {"volume.alpha_ng", v.alpha_ng}})
+    if (!(value <= kMaxLength))
+      throw InputError(describe(key, value) + " must be <= " + value_text(kMaxLength));
   if (v.distance != DistanceMode::kPlane && v.distance != DistanceMode::k3d)
     throw InputError("parameter 'volume.distance' = " + std::to_string(static_cast<int>(v.distance)) +
                      " must be plane or 3d");
-  require_positive("categorize.goal_dz", categorize.goal_dz);
+  require_between("categorize.goal_dz", categorize.goal_dz, kMinGoalDz, 10.0);
   require_between("categorize.trail_densify", categorize.trail_densify, 0, 1000);
-  require_positive("bounds.resolution", bounds.resolution);
-  require_non_negative("bounds.min_half_width", bounds.min_half_width);
-  require_non_negative("bounds.wrist_half_width", bounds.wrist_half_width);
+  require_between("bounds.resolution", bounds.resolution, kMinResolution, 1.0);
+  require_between("bounds.min_half_width", bounds.min_half_width, 0.0, kMaxLength);
+  require_between("bounds.wrist_half_width", bounds.wrist_half_width, 0.0, kMaxLength);
   require_between("bounds.linear_axis_tolerance", bounds.linear_axis_tolerance, 0.0, 1.0);
   require_between("cf.windows", cf.windows, 1, std::numeric_limits<int>::max());
   require_between("cf.samples", cf.samples, 1, std::numeric_limits<int>::max());

@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "leeway/categorize.hpp"
+#include "leeway/error.hpp"
 
 namespace leeway {
 namespace {
@@ -13,9 +14,22 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 
 }  // namespace
 
+void validate_for_scene(const Params& params, const Scene& scene) {
+  params.validate();
+  const auto kinds = bound_kinds(scene);
+  for (size_t i = 0; i < kinds.size(); ++i) {
+    const RobotJoint& j = scene.joints()[i];
+    if (kinds[i] == BoundKind::kBisected && !(2 * params.bounds.min_half_width < j.upper - j.lower))
+      throw InputError(scene.source() + ": parameter 'bounds.min_half_width' = " +
+                       format_number(params.bounds.min_half_width) +
+                       " rad must be smaller than half the range of joint '" + j.name + "' [" +
+                       format_number(j.lower) + ", " + format_number(j.upper) + "] rad");
+  }
+}
+
 BoundsRun compute_bounds(const Scene& scene, VolumeModel& world, const std::vector<Eigen::VectorXd>& path,
                          const Params& params, int threads) {
-  params.validate();
+  validate_for_scene(params, scene);
   BoundsRun run;
   auto t = std::chrono::steady_clock::now();
   run.categories = categorize(scene, path, params.categorize);

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "json_io.hpp"
+#include "leeway/bounds_file.hpp"
 #include "leeway/error.hpp"
 #include "leeway/mujoco_util.hpp"
 #include "offscreen.hpp"
@@ -244,6 +245,8 @@ BoundsSeries read_bounds_series(const std::string& path) {
   try {
     if (!j.is_object() || !j.contains("joints") || !j.contains("waypoints"))
       fail("not a leeway bounds file (needs 'joints' and 'waypoints')");
+    if (j.contains("format") && j.at("format") != nlohmann::json(kBoundsFormat))
+      fail("format " + j.at("format").dump() + " is not a leeway bounds file (" + kBoundsFormat + ")");
     out.joints = j.at("joints").get<std::vector<std::string>>();
     const size_t dof = out.joints.size();
     if (dof == 0) fail("'joints' is empty");

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "leeway/error.hpp"
+#include "leeway/params.hpp"
 
 namespace leeway {
 namespace {
@@ -114,9 +115,17 @@ void Scene::recognise(const SceneOptions& options) {
     rj.prismatic = m.jnt_type[j] == mjJNT_SLIDE;
     rj.lower = m.jnt_range[2 * j];
     rj.upper = m.jnt_range[2 * j + 1];
-    if (!std::isfinite(rj.lower) || !std::isfinite(rj.upper) || rj.lower >= rj.upper)
+    const char* unit = rj.prismatic ? " m" : " rad";
+    if (!std::isfinite(rj.lower) || !std::isfinite(rj.upper))
       throw InputError(file + ": joint " + label + " range '" + format_number(rj.lower) + " " +
-                       format_number(rj.upper) + "' is empty or not finite");
+                       format_number(rj.upper) + "' is not finite");
+    if (rj.lower >= rj.upper)
+      throw InputError(file + ": joint " + label + " range '" + format_number(rj.lower) + " " +
+                       format_number(rj.upper) + "' is empty");
+    if (std::abs(rj.lower) > kMaxLength || std::abs(rj.upper) > kMaxLength)
+      throw InputError(file + ": joint " + label + " range '" + format_number(rj.lower) + " " +
+                       format_number(rj.upper) + "'" + unit + " goes beyond +-" + format_number(kMaxLength) +
+                       unit + " (after MuJoCo's unit conversion); no robot joint moves that far");
     if (m.nuser_jnt > 0) {
       rj.max_speed = m.jnt_user[j * m.nuser_jnt];
       if (!std::isfinite(rj.max_speed) || rj.max_speed < 0)
@@ -198,6 +207,26 @@ void Scene::recognise(const SceneOptions& options) {
   // pose at qpos0 (none of them moves with the robot's joints), indexed for the midphase.
   DataPtr d = make_data(m);
   mj_kinematics(&m, d.get());
+  // Every collidable geom's size and pose must be finite numbers of workcell scale: MuJoCo compiles
+  // NaN and inf, and the collision checks would then answer nonsense.
+  for (int g = 0; g < m.ngeom; ++g) {
+    if (roles_[static_cast<size_t>(g)] == GeomRole::kIgnored) continue;
+    auto refuse = [&](const char* what, const mjtNum* v, int n, double limit, const char* unit) {
+      for (int i = 0; i < n; ++i)
+        if (!std::isfinite(v[i]) || std::abs(v[i]) > limit) {
+          std::string values;
+          for (int k = 0; k < n; ++k) values += (k ? " " : "") + format_number(v[k]);
+          throw InputError(file + ": geom '" + geom_label(g) + "' " + what + " '" + values + "'" + unit +
+                           (std::isfinite(v[i]) ? " goes beyond +-" + format_number(limit) + unit
+                                                : std::string(" is not finite")));
+        }
+    };
+    refuse("size", m.geom_size + 3 * g, 3, kMaxLength, " m");
+    refuse("pos", m.geom_pos + 3 * g, 3, kMaxLength, " m");
+    refuse("quat", m.geom_quat + 4 * g, 4, 2.0, "");
+    refuse("world position", d->geom_xpos + 3 * g, 3, kMaxLength, " m");
+    refuse("world orientation", d->geom_xmat + 9 * g, 9, 2.0, "");
+  }
   std::vector<int> statics;
   for (int g = 0; g < m.ngeom; ++g)
     if (roles_[static_cast<size_t>(g)] != GeomRole::kLink) statics.push_back(g);

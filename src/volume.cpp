@@ -393,6 +393,11 @@ Grid make_grid(const HeightMapParams& p, const Categories& c, const VolumeParams
   // Section 3.2.1: side = sqrt(x_dim y_dim / MAX_cells); x_L = x_dim / side and y_L = y_dim / side
   // "rounded to an integer value if needed" (at least one cell each).
   g.side = std::sqrt(x_dim * y_dim / p.max_cells);
+  // Params::validate bounds the extents; a map this small (or large) could still come from a caller.
+  if (!(g.side > 0) || !std::isfinite(g.side) || !(x_dim / g.side < 1e9) || !(y_dim / g.side < 1e9))
+    throw InputError("the height-map " + format_number(x_dim) + " x " + format_number(y_dim) +
+                     " m cannot be divided into 'height_map.max_cells' = " + std::to_string(p.max_cells) +
+                     " cells");
   const double rows = std::max(1.0, std::round(x_dim / g.side));
   const double cols = std::max(1.0, std::round(y_dim / g.side));
   // Only a map thinner than a quarter cell is rounded up this much; refuse rather than allocate.

@@ -393,8 +393,8 @@ bool VolumeChecker::in_collision(const Eigen::VectorXd& q) {
   }
   ++checks_;
   if (checker_ == CollisionChecker::kMidphase) return midphase_collision();
+  prevent_contact_warnings(d);  // a full contact buffer still answers "in collision"
   mj_collision(&world_->model(), &d);
-  take_mujoco_warnings();  // a full contact buffer still answers "in collision"
   return d.ncon > 0;
 }
 

@@ -11,6 +11,7 @@
 #include "cli/common.hpp"
 #include "distribute.hpp"
 #include "leeway/error.hpp"
+#include "leeway/file_io.hpp"
 #include "leeway/mujoco_util.hpp"
 #include "problem.hpp"
 #include "stages.hpp"
@@ -46,19 +47,25 @@ int main(int argc, char** argv) {
   Problem pb;
   Options& o = pb.o;
   o.cf.samples = 1000;
-  app.add_option("--case", o.cases, "A case CELL.xml:FROM:TO (repeat for more)")->required();
+  app.add_option("--case", o.cases, "A case CELL.xml:FROM:TO (repeat for more; required)");
   app.add_option(
       "--budget-evals", o.budget_evals,
       "Stop after this many evaluations (0: no limit; default 150, no limit with --budget-seconds)");
   app.add_option("--budget-seconds", o.budget_seconds,
                  "Stop the search after this wall time [s] (0: no limit)")
+      ->check(leeway::cli::finite_check())
       ->capture_default_str();
   app.add_option("--seed", o.seed, "Seed of the stochastic algorithms, the calibration and --noise-study")
+      ->check(leeway::cli::seed_check_for(o.seed))
       ->capture_default_str();
-  app.add_option("--out", o.out, "Tuned parameter file (for leeway bounds --params)")->capture_default_str();
-  app.add_option("--log", o.log, "CSV log of every evaluation");
-  app.add_option("--report", o.report, "JSON report: settings, time proxy, before/after summary");
-  app.add_option("--params", o.params, "Base parameter file: its keys apply to every case before tuning");
+  app.add_option("--out", o.out, "Tuned parameter file (for leeway bounds --params)")
+      ->check(leeway::cli::file_name_check())
+      ->capture_default_str();
+  app.add_option("--log", o.log, "CSV log of every evaluation")->check(leeway::cli::file_name_check());
+  app.add_option("--report", o.report, "JSON report: settings, time proxy, before/after summary")
+      ->check(leeway::cli::file_name_check());
+  app.add_option("--params", o.params, "Base parameter file: its keys apply to every case before tuning")
+      ->check(leeway::cli::file_name_check());
   app.add_option("--algorithm", o.algorithm,
                  "Stages joined by '+', e.g. direct+cobyla; stages: " + leeway::tune::stage_names())
       ->capture_default_str();
@@ -88,10 +95,12 @@ int main(int argc, char** argv) {
   app.add_option("--cf-samples", o.cf.samples, "CF samples per window during the search")
       ->capture_default_str();
   app.add_option("--cf-seed", o.cf.seed, "CF seed during the search (the same for every evaluation)")
+      ->check(leeway::cli::seed_check_for(o.cf.seed))
       ->capture_default_str();
   app.add_option("--final-samples", o.final_samples, "CF samples per window in the summary")
       ->capture_default_str();
   app.add_option("--final-seed", o.final_seed, "CF seed in the summary (not --cf-seed: fresh samples)")
+      ->check(leeway::cli::seed_check_for(o.final_seed))
       ->capture_default_str();
   app.add_option("--final-repeats", o.final_repeats, "Runs whose median is a summary time")
       ->capture_default_str();
@@ -108,17 +117,20 @@ int main(int argc, char** argv) {
   app.add_option("--noise-study", o.noise_study,
                  "Instead of tuning: evaluate the start and K-1 random points repeatedly into --log");
   app.add_option("--noise-center", o.noise_center,
-                 "--noise-study around this parameter file's point instead of over the whole box");
+                 "--noise-study around this parameter file's point instead of over the whole box")
+      ->check(leeway::cli::file_name_check());
   app.add_option("--noise-radius", o.noise_radius, "--noise-center's moves, as a fraction of each range")
       ->capture_default_str();
   app.add_option("--tool", o.tool, "Name of the robot's tool site")->capture_default_str();
 
   return leeway::cli::run_reporting_errors("leeway-tune", [&]() -> int {
-    if (const auto code = leeway::cli::parse_cli(app, argc, argv)) return *code;
+    if (const auto code = leeway::cli::parse_cli(app, argc, argv, "leeway-tune")) return *code;
     if (app.count("--budget-evals") == 0 && o.budget_seconds > 0) o.budget_evals = 0;
     leeway::install_mujoco_error_handlers();
     pb.command = "leeway-tune";
     for (int i = 1; i < argc; ++i) pb.command += std::string(" ") + argv[i];
+    leeway::install_temp_file_cleanup();
+    require(!o.cases.empty(), "--case is required: give at least one case CELL.xml:FROM:TO");
     load(pb);
     // Under mpirun every rank has loaded the problem; ranks other than 0 evaluate cases for rank 0.
     const auto pool = leeway::dist::make_pool(case_handler(pb));
@@ -127,15 +139,16 @@ int main(int argc, char** argv) {
       return leeway::kExitOk;
     }
     pb.pool = pool.get();
-    std::ofstream log;
-    if (!o.log.empty()) {
-      log.open(o.log);
-      require(static_cast<bool>(log), "--log " + o.log + ": cannot write");
-    }
     install_sigint_handler();
     if (!calibrate(pb)) {
       std::cerr << "leeway-tune: interrupted before the first evaluation; nothing written\n";
       return kExitInterrupted;
+    }
+    // Opened (and an existing log replaced) only now: an interrupted calibration leaves it as it was.
+    std::ofstream log;
+    if (!o.log.empty()) {
+      log.open(o.log);
+      require(static_cast<bool>(log), "--log " + o.log + ": cannot write");
     }
     if (o.noise_study > 0) return noise_study(pb, log);
     return tune(pb, log.is_open() ? &log : nullptr);

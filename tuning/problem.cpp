@@ -9,6 +9,9 @@
 #include <sstream>
 #include <thread>
 
+#include "cli/common.hpp"
+#include "json_io.hpp"
+#include "leeway/file_io.hpp"
 #include "tuner.hpp"
 
 namespace leeway::tune_cli {
@@ -147,8 +150,14 @@ void load(Problem& pb) {
           "give a budget: --budget-evals N or --budget-seconds S");
   require(o.repeats >= 1, "--repeats " + std::to_string(o.repeats) + " must be >= 1");
   require(o.final_repeats >= 1, "--final-repeats must be >= 1");
-  require(o.threads >= 1, "--threads " + std::to_string(o.threads) + " must be >= 1");
+  require(o.threads >= 1 && o.threads <= leeway::cli::kMaxThreads,
+          "--threads " + std::to_string(o.threads) + " must be from 1 to " +
+              std::to_string(leeway::cli::kMaxThreads));
   require(o.cf.windows >= 1 && o.cf.samples >= 1, "--cf-windows and --cf-samples must be >= 1");
+  leeway::cli::require_memory(o.cf.windows * leeway::cli::kBytesPerWindow,
+                              "--cf-windows " + std::to_string(o.cf.windows));
+  leeway::cli::require_memory(o.waypoints * leeway::cli::kBytesPerWaypoint,
+                              "--waypoints " + std::to_string(o.waypoints));
   require(o.final_samples >= 1, "--final-samples must be >= 1");
   require(o.recheck >= 0 && o.noise_study >= 0, "--recheck and --noise-study must be >= 0");
   require(o.noise_study == 0 || !o.log.empty(), "--noise-study writes its rows to --log FILE: give one");
@@ -159,13 +168,7 @@ void load(Problem& pb) {
   leeway::tune::parse_stages(o.algorithm, o.global_share);  // throws on an unknown stage
 
   if (!o.params.empty()) {
-    std::ifstream in(o.params);
-    if (!in) throw InputError(o.params + ": cannot open the parameter file");
-    try {
-      pb.base_json = json::parse(in);
-    } catch (const json::exception& e) {
-      throw InputError(o.params + ": malformed JSON: " + e.what());
-    }
+    pb.base_json = leeway::detail::read_json_file(o.params, "parameter file");
     leeway::params_from_json(pb.base_json, o.params).validate();
   }
 
@@ -240,6 +243,13 @@ void load(Problem& pb) {
     const auto dir = std::filesystem::absolute(file).parent_path();
     require(std::filesystem::is_directory(dir),
             std::string(flag) + " " + file + ": the directory " + dir.string() + " does not exist");
+    std::vector<std::string> inputs = {o.params, o.noise_center};
+    for (const auto& text : o.cases) inputs.push_back(leeway::parse_case(text).cell);
+    try {
+      leeway::require_regular_output(file, inputs);
+    } catch (const InputError& e) {
+      throw InputError(std::string(flag) + " " + e.what());
+    }
   }
 
   pb.report["command"] = pb.command;

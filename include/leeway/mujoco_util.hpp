@@ -33,6 +33,12 @@ void install_mujoco_error_handlers();
 //! Returns and clears the MuJoCo warnings raised on this thread since the last call.
 std::vector<std::string> take_mujoco_warnings();
 
+//! Marks MuJoCo's contact- and constraint-buffer warnings as already raised in `d`, so that
+//! mj_collision on a full buffer (still "in collision": ncon > 0) neither formats nor reports a
+//! warning. MuJoCo formats warning text in one process-wide buffer, so worker threads must not raise
+//! warnings; leeway calls this before every mj_collision.
+void prevent_contact_warnings(mjData& d);
+
 //! Compiles an MJCF (or MJB) file.
 //! @throws InputError naming the file when it is missing, unreadable or does not compile.
 ModelPtr load_model_file(const std::string& path);

@@ -21,6 +21,17 @@ enum class DistanceMode {
 //! Params::validate, make_grid and the programs' options all check against this one value.
 constexpr int kMaxCellsLimit = 1000000;
 
+//! Physical bounds on the input (issue 14): a workcell is metres across, so lengths (parameters,
+//! joint ranges of slide joints [m], obstacle positions and sizes) and hinge ranges [rad] beyond
+//! this are refused as mistakes; they would only produce unusable bounds or overflow.
+constexpr double kMaxLength = 1e3;
+//! The smallest height-map side and reach radius [m]: below it the map's cell size underflows.
+constexpr double kMinMapSide = 1e-3;
+//! The smallest Algorithm-1 descent step 'categorize.goal_dz' [m] (smaller ones run for ever).
+constexpr double kMinGoalDz = 1e-5;
+//! The smallest Algorithm-2 step 'bounds.resolution' [rad] (smaller ones run for ever).
+constexpr double kMinResolution = 1e-6;
+
 //! The height-map of section 3.2.1.
 struct HeightMapParams {
   //! When true, the map is the rectangle covering every floor point within reach_radius of every

@@ -27,6 +27,12 @@ struct BoundsRun {
   double ms_total() const { return ms_categorize + ms_volume + ms_inject + ms_bounds + ms_safety; }
 };
 
+//! Checks `params` against the robot of `scene` (Params::validate checks them alone):
+//! 'bounds.min_half_width' must be smaller than half the range of every bisected (hinge) joint, or
+//! the collapse guard would "widen" an interval to the joint's whole range.
+//! @throws InputError naming the parameter, the joint, the file and the values.
+void validate_for_scene(const Params& params, const Scene& scene);
+
 //! Runs the method on a path against a prepared VolumeModel (its one-off set-up is not timed), then
 //! the safety stage of params.safety.mode against the real obstacles.
 //! @throws InputError on invalid parameters or waypoints.

@@ -1,5 +1,6 @@
 #include "cli/bounds.hpp"
 
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -65,24 +66,31 @@ CLI::App* add_bounds(CLI::App& app, BoundsArgs& args) {
   sub->add_option("cell", args.cell, "MJCF file of the workcell")->required();
   add_checker_option(sub, args.checker);
   auto* path_opt =
-      sub->add_option("--path", args.path, "Path file written by leeway plan --out (instead of --from/--to)");
+      sub->add_option("--path", args.path, "Path file written by leeway plan --out (instead of --from/--to)")
+          ->check(file_name_check());
   sub->add_option("--from", args.from, "Start: a keyframe, site:NAME or xyz:X,Y,Z")->excludes(path_opt);
   sub->add_option("--to", args.to, "Goal: a keyframe, site:NAME or xyz:X,Y,Z")->excludes(path_opt);
   sub->add_option("--waypoints", args.waypoints,
                   "Waypoints along the joint-linear path between two keyframes (>= 2; the thesis: 2)")
       ->capture_default_str();
-  sub->add_option("--seed", args.plan.seed, "Planner seed (gripper goals)")->capture_default_str();
+  sub->add_option("--seed", args.plan.seed, "Planner seed (gripper goals)")
+      ->check(seed_check_for(args.plan.seed))
+      ->capture_default_str();
   sub->add_option("--time-limit", args.plan.time_limit, "Planner time budget [s] (gripper goals)")
+      ->check(finite_check())
       ->capture_default_str();
   sub->add_option("--ik-seed", args.ik_seed, "Keyframe seeding the inverse kinematics of gripper goals");
   sub->add_option("--max-cells", args.max_cells,
                   "MAX_cells of the height-map (default: from --params, 20000)");
-  sub->add_option("--params", args.params, "Parameter file (JSON; see leeway params)");
+  sub->add_option("--params", args.params, "Parameter file (JSON; see leeway params)")
+      ->check(file_name_check());
   add_preset_options(sub, args.preset, args.safety);
-  sub->add_option("--out", args.out, "Write the bounds file here (JSON)");
+  sub->add_option("--out", args.out, "Write the bounds file here (JSON)")->check(file_name_check());
   sub->add_option("--export-mjcf", args.export_mjcf,
-                  "Write the cell with its volume as MJCF (named visual-only box geoms) for mujoco-simulate");
-  sub->add_option("--export-mjb", args.export_mjb, "Write the same model compiled, as MuJoCo's binary MJB");
+                  "Write the cell with its volume as MJCF (named visual-only box geoms) for mujoco-simulate")
+      ->check(file_name_check());
+  sub->add_option("--export-mjb", args.export_mjb, "Write the same model compiled, as MuJoCo's binary MJB")
+      ->check(file_name_check());
   sub->add_option("--threads", args.threads, "Worker threads")->capture_default_str();
   sub->add_flag("--json", args.json, "Print the bounds file to standard output");
   sub->add_flag("--no-plan", args.no_plan,
@@ -95,14 +103,22 @@ CLI::App* add_bounds(CLI::App& app, BoundsArgs& args) {
 }
 
 int run_bounds(const BoundsArgs& args) {
+  const bool cell_is_mjb = std::filesystem::path(args.cell).extension() == ".mjb";
+  if (cell_is_mjb && (!args.export_mjcf.empty() || !args.export_mjb.empty()))
+    throw InputError(std::string(args.export_mjcf.empty() ? "--export-mjb" : "--export-mjcf") +
+                     " needs the cell's MJCF text; " + args.cell +
+                     " is a compiled MuJoCo model (.mjb): give the cell's .xml file");
   const auto scene = Scene::load(args.cell, scene_options(kDefaultTool, args.checker));
   Params p = load_params(scene, args.preset, args.params, args.safety);
   if (args.max_cells_given) p.height_map.max_cells = args.max_cells;
   p.validate();
-  if (args.threads < 1) throw InputError("--threads " + std::to_string(args.threads) + " must be >= 1");
-  if (!args.out.empty()) require_output(args.out, "--out");
-  if (!args.export_mjcf.empty()) require_output(args.export_mjcf, "--export-mjcf", {".xml"});
-  if (!args.export_mjb.empty()) require_output(args.export_mjb, "--export-mjb", {".mjb"});
+  require_threads(args.threads);
+  const std::vector<std::string> inputs = {args.cell, args.params, args.path};
+  if (!args.out.empty()) require_output(args.out, "--out", {}, inputs);
+  if (!args.export_mjcf.empty()) require_output(args.export_mjcf, "--export-mjcf", {".xml"}, inputs);
+  if (!args.export_mjb.empty()) require_output(args.export_mjb, "--export-mjb", {".mjb"}, inputs);
+  require_distinct_outputs(
+      {{args.out, "--out"}, {args.export_mjcf, "--export-mjcf"}, {args.export_mjb, "--export-mjb"}});
   std::vector<Eigen::VectorXd> path;
   std::string label = args.from + " -> " + args.to;
   const bool linear = args.path.empty() && !is_gripper_goal(args.from) && !is_gripper_goal(args.to);
@@ -120,6 +136,7 @@ int run_bounds(const BoundsArgs& args) {
     // The library names the data; the command line names its flag.
     if (args.waypoints < 2)
       throw InputError("--waypoints " + std::to_string(args.waypoints) + " must be >= 2");
+    require_memory(args.waypoints * kBytesPerWaypoint, "--waypoints " + std::to_string(args.waypoints));
     path = keyframe_path(scene, args.from, args.to, args.waypoints);
   } else {
     PlanResult planned;

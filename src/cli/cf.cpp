@@ -16,7 +16,9 @@ CLI::App* add_cf(CLI::App& app, CfArgs& args) {
   sub->add_option("--windows", args.params.windows, "Windows along the path")->capture_default_str();
   sub->add_option("--samples", args.params.samples, "Random configurations per window")
       ->capture_default_str();
-  sub->add_option("--seed", args.params.seed, "Random seed")->capture_default_str();
+  sub->add_option("--seed", args.params.seed, "Random seed")
+      ->check(seed_check_for(args.params.seed))
+      ->capture_default_str();
   sub->add_option("--threads", args.threads, "Worker threads")->capture_default_str();
   sub->add_flag("--json", args.json, "Print JSON");
   return sub;
@@ -24,7 +26,9 @@ CLI::App* add_cf(CLI::App& app, CfArgs& args) {
 
 int run_cf(const CfArgs& args) {
   const auto scene = Scene::load(args.cell, scene_options(kDefaultTool, args.checker));
-  if (args.threads < 1) throw InputError("--threads " + std::to_string(args.threads) + " must be >= 1");
+  require_threads(args.threads);
+  if (args.params.windows >= 1)
+    require_memory(args.params.windows * kBytesPerWindow, "--windows " + std::to_string(args.params.windows));
   const auto wb = read_bounds(args.bounds, scene);
   const auto r = confidence_factor(scene, wb, args.params, args.threads);
   if (args.json) {

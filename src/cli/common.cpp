@@ -1,7 +1,13 @@
 #include "cli/common.hpp"
 
 #include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <regex>
 #include <thread>
@@ -10,6 +16,7 @@
 #include "json_io.hpp"
 #include "leeway/cell_defaults.hpp"
 #include "leeway/endpoints.hpp"
+#include "leeway/file_io.hpp"
 #include "leeway/planner.hpp"
 
 namespace leeway::cli {
@@ -104,7 +111,7 @@ bool plan_between(const Scene& scene, const std::string& from, const std::string
 }
 
 void require_output(const std::string& path, const std::string& flag,
-                    const std::vector<std::string>& extensions) {
+                    const std::vector<std::string>& extensions, const std::vector<std::string>& inputs) {
   namespace fs = std::filesystem;
   if (path.empty()) throw InputError(flag + ": the output file name is empty");
   if (!extensions.empty()) {
@@ -121,6 +128,30 @@ void require_output(const std::string& path, const std::string& flag,
     throw InputError(flag + " " + path + ": cannot write there (folder '" + folder.string() +
                      "' missing or not writable)");
   if (fs::is_directory(path, ec)) throw InputError(flag + " " + path + ": is a folder, not a file");
+  try {
+    require_regular_output(path, inputs);
+  } catch (const InputError& e) {
+    throw InputError(flag + " " + e.what());
+  }
+}
+
+void require_distinct_outputs(const std::vector<std::pair<std::string, std::string>>& outputs) {
+  namespace fs = std::filesystem;
+  for (size_t i = 0; i < outputs.size(); ++i)
+    for (size_t k = i + 1; k < outputs.size(); ++k) {
+      const auto& [a, fa] = outputs[i];
+      const auto& [b, fb] = outputs[k];
+      if (a.empty() || b.empty()) continue;
+      std::error_code ec;
+      if (fs::weakly_canonical(a, ec) == fs::weakly_canonical(b, ec))
+        throw InputError(fa + " and " + fb + " name the same file " + a);
+    }
+}
+
+void require_threads(int threads, const std::string& flag) {
+  if (threads < 1 || threads > kMaxThreads)
+    throw InputError(flag + " " + std::to_string(threads) + " must be from 1 to " +
+                     std::to_string(kMaxThreads));
 }
 
 std::pair<int, int> parse_size(const std::string& text, const std::string& flag) {

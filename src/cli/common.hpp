@@ -4,8 +4,16 @@
 
 #include <CLI/CLI.hpp>
 #include <Eigen/Core>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <iostream>
+#include <limits>
+#include <new>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -23,10 +31,13 @@ namespace leeway::cli {
 //! The tool site's name unless --tool gives another.
 inline const char* const kDefaultTool = "tool0";
 
+//! Most worker threads a program accepts (--threads).
+inline constexpr int kMaxThreads = 256;
+
 //! Parses argv into `app`. Returns the exit code the program should return now (0 after --help or
-//! --version, kExitBadInput after a parse error, which CLI11 has reported on standard error), or
-//! nothing when the program should go on.
-inline std::optional<int> parse_cli(CLI::App& app, int argc, char** argv) {
+//! --version, kExitBadInput after a parse error, reported as one line "PROGRAM: error: ..." on
+//! standard error), or nothing when the program should go on.
+inline std::optional<int> parse_cli(CLI::App& app, int argc, char** argv, const char* program = "leeway") {
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -36,26 +47,117 @@ inline std::optional<int> parse_cli(CLI::App& app, int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    app.exit(e);
+    std::string message = e.what();
+    for (char& ch : message)
+      if (ch == '\n' || ch == '\r') ch = ' ';
+    while (!message.empty() && message.back() == ' ') message.pop_back();
+    std::cerr << program << ": error: " << message << " (see " << program << " --help)\n";
     return kExitBadInput;
   }
   return std::nullopt;
 }
 
+//! Flushes standard output and checks that everything written to it arrived: a full disk, a
+//! closed pipe or /dev/full must not end in exit 0. Returns `code`, or kExitBadInput after one line
+//! on standard error when the output was lost.
+inline int finish_stdout(const char* program, int code) {
+  std::cout.flush();
+  const bool lost = !std::cout || std::fflush(stdout) != 0 || std::ferror(stdout);
+  if (!lost) return code;
+  const int err = errno;
+  std::cout.clear();
+  std::cerr << program << ": error: standard output: writing failed (" << std::strerror(err ? err : EIO)
+            << "); the output is incomplete\n";
+  return kExitBadInput;
+}
+
 //! Runs a program's `body` (returning its exit code) and turns an escaping exception into one line
-//! on standard error: an InputError gives "PROGRAM: error: ..." and kExitBadInput, anything else
-//! "PROGRAM: internal error (please report): ..." and kExitInternal.
+//! on standard error: an InputError gives "PROGRAM: error: ..." and kExitBadInput, an allocation
+//! failure "PROGRAM: error: out of memory ..." and kExitBadInput, anything else
+//! "PROGRAM: internal error (please report): ..." and kExitInternal. Standard output is flushed and
+//! checked before an exit code is returned (finish_stdout).
 template <class Body>
 int run_reporting_errors(const char* program, Body&& body) {
+  int code = kExitInternal;
   try {
-    return body();
+    code = body();
   } catch (const InputError& e) {
     std::cerr << program << ": error: " << e.what() << "\n";
-    return kExitBadInput;
+    code = kExitBadInput;
+  } catch (const std::bad_alloc&) {
+    std::cerr << program
+              << ": error: out of memory: the input needs more memory than the system grants"
+                 " (fewer waypoints, windows, samples or MAX_cells need less); nothing written\n";
+    code = kExitBadInput;
   } catch (const std::exception& e) {
     std::cerr << program << ": internal error (please report): " << e.what() << "\n";
-    return kExitInternal;
+    code = kExitInternal;
   }
+  return finish_stdout(program, code);
+}
+
+//! Memory leeway lets the command line ask for in the data it sizes (waypoints, CF windows), in
+//! bytes: above it a run is refused up front rather than ending in an allocation failure.
+inline constexpr double kMemoryLimit = 4.0 * 1024 * 1024 * 1024;
+
+//! Estimated bytes per waypoint of a bounded path (the path, its intervals, the safety stage's
+//! segments and the bounds file as JSON), for require_memory.
+inline constexpr double kBytesPerWaypoint = 4096;
+
+//! Estimated bytes per CF window (its counts, its CF and its entry in the JSON output).
+inline constexpr double kBytesPerWindow = 96;
+
+//! Refuses `what` ("--waypoints 1000000000") when `bytes` exceeds kMemoryLimit.
+//! @throws InputError with the estimate and the limit.
+inline void require_memory(double bytes, const std::string& what) {
+  if (bytes <= kMemoryLimit) return;
+  auto gib = [](double b) { return format_number(b / (1024.0 * 1024 * 1024)); };
+  throw InputError(what + " would need about " + gib(bytes) + " GiB of memory (estimated); the limit is " +
+                   gib(kMemoryLimit) + " GiB");
+}
+
+//! Checks --threads: from 1 to kMaxThreads. @throws InputError naming the flag and the value.
+void require_threads(int threads, const std::string& flag = "--threads");
+
+//! A CLI11 check for a seed: a whole number from 0 to `max` written in decimal digits (CLI11 would
+//! wrap "-1" and round 1e23 to the largest value).
+inline CLI::Validator seed_check(std::uint64_t max = std::numeric_limits<std::uint64_t>::max()) {
+  return CLI::Validator(
+      [max](std::string& text) -> std::string {
+        const std::string bad = "'" + text + "' must be a whole number from 0 to " + std::to_string(max);
+        if (text.empty() || text.size() > 20 || text.find_first_not_of("0123456789") != std::string::npos)
+          return bad;
+        errno = 0;
+        const unsigned long long v = std::strtoull(text.c_str(), nullptr, 10);
+        if (errno == ERANGE || v > max) return bad;
+        return "";
+      },
+      "");
+}
+
+//! seed_check up to the largest value of the seed's type.
+template <class T>
+CLI::Validator seed_check_for(const T&) {
+  return seed_check(static_cast<std::uint64_t>(std::numeric_limits<T>::max()));
+}
+
+//! A CLI11 check for a file name: not empty.
+inline CLI::Validator file_name_check() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string { return text.empty() ? "the file name is empty" : ""; }, "");
+}
+
+//! A CLI11 check for a number: finite (CLI11 accepts "nan" and "inf" for a double).
+inline CLI::Validator finite_check() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (end == text.c_str() || *end != '\0') return "'" + text + "' is not a number";
+        if (!std::isfinite(v)) return "'" + text + "' is not a finite number";
+        return "";
+      },
+      "");
 }
 
 //! Scene options with the given tool site and collision checker ("midphase" or "mujoco").
@@ -97,11 +199,18 @@ bool plan_between(const Scene& scene, const std::string& from, const std::string
                   const std::string& ik_seed_key, const PlanOptions& options, PlanResult& result, Endpoint& a,
                   Endpoint& b);
 
-//! Checks, before any work, that an output file can be written: its folder exists and is writable
-//! and, when `extensions` is not empty, its name ends in one of them (".png"). `flag` names the option.
+//! Checks, before any work, that an output file can be written: its folder exists and is writable,
+//! it is not an existing folder, FIFO, device or other non-regular file, it is none of `inputs`
+//! (the same file by std::filesystem::equivalent) and, when `extensions` is not empty, its name ends
+//! in one of them (".png"). `flag` names the option.
 //! @throws InputError naming the flag and the path otherwise.
 void require_output(const std::string& path, const std::string& flag,
-                    const std::vector<std::string>& extensions = {});
+                    const std::vector<std::string>& extensions = {},
+                    const std::vector<std::string>& inputs = {});
+
+//! Refuses two of `outputs` (path, flag; empty paths skipped) that name the same file.
+//! @throws InputError naming both flags.
+void require_distinct_outputs(const std::vector<std::pair<std::string, std::string>>& outputs);
 
 //! Parses an image size "WIDTHxHEIGHT" [pixels]. @throws InputError naming `flag` and the value.
 std::pair<int, int> parse_size(const std::string& text, const std::string& flag);

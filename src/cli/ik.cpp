@@ -25,13 +25,17 @@ CLI::App* add_ik(CLI::App& app, IkArgs& args) {
                 "Position only: do not require the tool to point down");
   sub->add_option("--restarts", args.options.restarts, "Random restarts after the seed")
       ->capture_default_str();
-  sub->add_option("--seed", args.options.seed, "Seed of the random restarts")->capture_default_str();
+  sub->add_option("--seed", args.options.seed, "Seed of the random restarts")
+      ->check(seed_check_for(args.options.seed))
+      ->capture_default_str();
   sub->add_flag("--json", args.json, "Print JSON");
   add_tool_option(sub, args.tool);
   return sub;
 }
 
 int run_ik(const IkArgs& args) {
+  if (args.options.restarts < 0 || args.options.restarts > 100000)
+    throw InputError("--restarts " + std::to_string(args.options.restarts) + " must be from 0 to 100000");
   const auto scene = Scene::load(args.cell, scene_options(args.tool));
   Eigen::Vector3d target;
   if (!args.site.empty()) {

@@ -3,6 +3,7 @@
 #include <cstdlib>
 #include <iostream>
 
+#include "cli/common.hpp"
 #include "leeway/error.hpp"
 #include "leeway/file_io.hpp"
 #include "leeway/urdf_import.hpp"
@@ -14,7 +15,9 @@ CLI::App* add_import_urdf(CLI::App& app, ImportUrdfArgs& args) {
       "import-urdf",
       "Import a URDF robot as an MJCF robot fragment in leeway's conventions (docs/robots.md)");
   sub->add_option("urdf", args.urdf, "The URDF file (run xacro first for .xacro files)")->required();
-  sub->add_option("--out", args.out, "The MJCF fragment to write, e.g. mjcf/robots/NAME.xml")->required();
+  sub->add_option("--out", args.out, "The MJCF fragment to write, e.g. mjcf/robots/NAME.xml")
+      ->check(file_name_check())
+      ->required();
   sub->add_option("--package-path", args.package_paths,
                   "A folder holding ROS packages, for package:// URIs (repeatable; searched before\n"
                   "ROS_PACKAGE_PATH)");
@@ -28,6 +31,7 @@ CLI::App* add_import_urdf(CLI::App& app, ImportUrdfArgs& args) {
 }
 
 int run_import_urdf(const ImportUrdfArgs& args) {
+  require_output(args.out, "--out", {}, {args.urdf});
   UrdfImportOptions options;
   options.package_paths = args.package_paths;
   if (const char* env = std::getenv("ROS_PACKAGE_PATH")) options.ros_package_path = env;

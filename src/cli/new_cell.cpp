@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "cli/common.hpp"
 #include "leeway/error.hpp"
 #include "leeway/new_cell.hpp"
 
@@ -13,13 +14,16 @@ CLI::App* add_new_cell(CLI::App& app, NewCellArgs& args) {
       "new-cell",
       "Write a minimal cell around a robot fragment (floor, robot, home keyframe) that passes check");
   sub->add_option("--robot", args.robot, "The robot's MJCF fragment, e.g. mjcf/robots/NAME.xml")->required();
-  sub->add_option("--out", args.out, "The cell to write, e.g. mjcf/workcells/NAME.xml")->required();
+  sub->add_option("--out", args.out, "The cell to write, e.g. mjcf/workcells/NAME.xml")
+      ->check(file_name_check())
+      ->required();
   sub->add_option("--name", args.name,
                   "The cell's model name (default: the file name without its extension)");
   return sub;
 }
 
 int run_new_cell(const NewCellArgs& args) {
+  require_output(args.out, "--out", {}, {args.robot});
   const std::string name = args.name.empty() ? std::filesystem::path(args.out).stem().string() : args.name;
   const NewCell cell = write_new_cell(args.robot, args.out, name);
   std::cout << "wrote " << args.out << ": includes " << cell.robot_include << ", " << cell.joints

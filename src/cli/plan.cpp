@@ -22,20 +22,29 @@ CLI::App* add_plan(CLI::App& app, PlanArgs& args) {
   add_checker_option(sub, args.checker);
   sub->add_option("--from", args.from, "Start: a keyframe, site:NAME or xyz:X,Y,Z [m]")->required();
   sub->add_option("--to", args.to, "Goal: a keyframe, site:NAME or xyz:X,Y,Z [m]")->required();
-  sub->add_option("--seed", o.seed, "Random seed (same seed, same path)")->capture_default_str();
-  sub->add_option("--time-limit", o.time_limit, "RRT-Connect's time budget [s]")->capture_default_str();
+  sub->add_option("--seed", o.seed, "Random seed (same seed, same path)")
+      ->check(seed_check_for(o.seed))
+      ->capture_default_str();
+  sub->add_option("--time-limit", o.time_limit, "RRT-Connect's time budget [s]")
+      ->check(finite_check())
+      ->capture_default_str();
   sub->add_option("--resolution", o.resolution, "Motion resolution of hinge joints [rad]")
+      ->check(finite_check())
       ->capture_default_str();
   sub->add_option("--slide-resolution", o.slide_resolution, "Motion resolution of slide joints [m]")
+      ->check(finite_check())
       ->capture_default_str();
   sub->add_option("--range", o.range, "RRT-Connect's longest extension [rad]; 0 = OMPL's default")
+      ->check(finite_check())
       ->capture_default_str();
-  sub->add_option("--clearance", o.clearance, "Clearance margin to the obstacles [m]")->capture_default_str();
+  sub->add_option("--clearance", o.clearance, "Clearance margin to the obstacles [m]")
+      ->check(finite_check())
+      ->capture_default_str();
   sub->add_flag("--no-simplify", args.no_simplify, "Keep RRT-Connect's raw path");
   sub->add_flag("--no-direct", args.no_direct,
                 "Run RRT-Connect even when the joint-linear edge from start to goal is free");
   sub->add_option("--ik-seed", args.ik_seed, "Keyframe seeding the inverse kinematics of gripper goals");
-  sub->add_option("--out", args.out, "Write the path file here (JSON)");
+  sub->add_option("--out", args.out, "Write the path file here (JSON)")->check(file_name_check());
   sub->add_flag("--json", args.json, "Print the path file to standard output");
   add_tool_option(sub, args.tool);
   return sub;
@@ -43,6 +52,7 @@ CLI::App* add_plan(CLI::App& app, PlanArgs& args) {
 
 int run_plan(const PlanArgs& args) {
   const auto scene = Scene::load(args.cell, scene_options(args.tool, args.checker));
+  if (!args.out.empty()) require_output(args.out, "--out", {}, {args.cell});
   PlanOptions options = args.options;
   options.simplify = !args.no_simplify;
   options.try_direct = !args.no_direct;

@@ -19,7 +19,9 @@ CLI::App* add_plot(CLI::App& app, PlotArgs& args) {
                   "A bounds file written by leeway bounds --out, or sweep CSV files written by leeway sweep\n"
                   "--csv (one series each: boxes, time and CF against MAX_cells)")
       ->required();
-  sub->add_option("--out", args.out, "Plot file to write: .svg or .png")->required();
+  sub->add_option("--out", args.out, "Plot file to write: .svg or .png")
+      ->check(file_name_check())
+      ->required();
   sub->add_option("--size", args.size,
                   "Image size WIDTHxHEIGHT [pixels] (default: bounds 1000 wide and 240 per row of panels;\n"
                   "sweeps 1200x420)");
@@ -64,7 +66,7 @@ int plot_sweeps(const PlotArgs& args, int width, int height) {
 }  // namespace
 
 int run_plot(const PlotArgs& args) {
-  require_output(args.out, "--out", {".svg", ".png"});
+  require_output(args.out, "--out", {".svg", ".png"}, args.inputs);
   int width = 0, height = 0;
   if (!args.size.empty()) std::tie(width, height) = parse_size(args.size, "--size");
   const bool csv = is_csv(args.inputs.front());

@@ -34,13 +34,14 @@ CLI::App* add_render(CLI::App& app, RenderArgs& args) {
       "height and ghosts of the robot at the extremes of its intervals. Exit 0 on success, 1 when the\n"
       "straight path between the keyframes collides, 2 bad input (nothing written).");
   sub->add_option("cell", args.cell, "MJCF file of the workcell")->required();
-  auto* bounds = sub->add_option("--bounds", args.bounds, "Bounds file written by leeway bounds --out");
+  auto* bounds = sub->add_option("--bounds", args.bounds, "Bounds file written by leeway bounds --out")
+                     ->check(file_name_check());
   sub->add_option("--from", args.from, "Keyframe the path starts at (bounds computed here)")
       ->excludes(bounds);
   sub->add_option("--to", args.to, "Keyframe the path ends at")->excludes(bounds);
   sub->add_option("--key", args.key, "Keyframe to show without bounds (default: the cell's first)")
       ->excludes(bounds);
-  sub->add_option("--out", args.out, "PNG file to write")->required();
+  sub->add_option("--out", args.out, "PNG file to write")->check(file_name_check())->required();
   sub->add_option("--waypoint", args.waypoint, "Waypoint shown, from 0 (default: the last)");
   sub->add_option("--camera", args.camera,
                   "Camera \"az,el,dist\": azimuth and elevation [rad] (elevation < 0 looks down), distance\n"
@@ -57,7 +58,8 @@ CLI::App* add_render(CLI::App& app, RenderArgs& args) {
   sub->add_option("--waypoints", args.waypoints, "Waypoints along the joint-linear path (with --from/--to)")
       ->capture_default_str();
   sub->add_option("--max-cells", args.max_cells, "MAX_cells of the height-map (with --from/--to)");
-  sub->add_option("--params", args.params, "Parameter file (JSON; with --from/--to)");
+  sub->add_option("--params", args.params, "Parameter file (JSON; with --from/--to)")
+      ->check(file_name_check());
   add_preset_options(sub, args.preset, args.safety);
   sub->add_option("--threads", args.threads, "Worker threads")->capture_default_str();
   sub->final_callback([sub, &args] { args.max_cells_given = sub->count("--max-cells") > 0; });
@@ -66,7 +68,7 @@ CLI::App* add_render(CLI::App& app, RenderArgs& args) {
 
 int run_render(const RenderArgs& args) {
   // Every flag is checked before any work, so that bad input writes nothing.
-  require_output(args.out, "--out", {".png"});
+  require_output(args.out, "--out", {".png"}, {args.cell, args.bounds, args.params});
   const auto [width, height] = parse_size(args.size, "--size");
   if (args.volume != "on" && args.volume != "off")
     throw InputError("--volume '" + args.volume + "' must be on or off");
@@ -106,7 +108,7 @@ int run_render(const RenderArgs& args) {
   if (!with_path && args.bounds.empty() && args.waypoint != -1)
     throw InputError("--waypoint " + std::to_string(args.waypoint) +
                      ": there is no path without --bounds or --from/--to");
-  if (args.threads < 1) throw InputError("--threads " + std::to_string(args.threads) + " must be >= 1");
+  require_threads(args.threads);
 
   const auto scene = Scene::load(args.cell, scene_options(kDefaultTool));
   Params p = load_params(scene, args.preset, args.params, args.safety);

@@ -1,7 +1,10 @@
 #include "cli/sweep.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -20,6 +23,19 @@ const char* const kThesisCells =
     "100000";
 
 std::vector<int> parse_cells_list(const std::string& text) {
+  // parse_vector skips empty items; in a list of cells "1,,2" is more likely a mistake.
+  std::string item;
+  int index = 0;
+  for (const char c : text + ",") {
+    if (c != ',') {
+      if (!std::isspace(static_cast<unsigned char>(c))) item += c;
+      continue;
+    }
+    ++index;
+    if (item.empty())
+      throw InputError("--max-cells '" + text + "': value " + std::to_string(index) + " is empty");
+    item.clear();
+  }
   std::vector<int> out;
   const Eigen::VectorXd v = parse_vector(text, "--max-cells");
   for (Eigen::Index i = 0; i < v.size(); ++i) {
@@ -46,15 +62,18 @@ CLI::App* add_sweep(CLI::App& app, SweepArgs& args) {
       ->capture_default_str();
   sub->add_option("--max-cells", args.max_cells,
                   "Comma-separated MAX_cells values (default: the thesis's 20)");
-  sub->add_option("--params", args.params, "Parameter file (JSON)");
+  sub->add_option("--params", args.params, "Parameter file (JSON)")->check(file_name_check());
   add_preset_options(sub, args.preset, args.safety);
-  sub->add_option("--csv", args.csv, "Also write the table as CSV here");
+  sub->add_option("--csv", args.csv, "Also write the table as CSV here")->check(file_name_check());
   sub->add_option("--plot", args.plot,
                   "Also plot boxes, time and CF against MAX_cells here (.svg or .png), beside the thesis's\n"
-                  "published values when the case is one of its nine");
+                  "published values when the case is one of its nine")
+      ->check(file_name_check());
   sub->add_option("--windows", args.cf.windows, "CF windows")->capture_default_str();
   sub->add_option("--samples", args.cf.samples, "CF samples per window")->capture_default_str();
-  sub->add_option("--seed", args.cf.seed, "CF random seed")->capture_default_str();
+  sub->add_option("--seed", args.cf.seed, "CF random seed")
+      ->check(seed_check_for(args.cf.seed))
+      ->capture_default_str();
   sub->add_option("--threads", args.threads, "Worker threads")->capture_default_str();
   sub->final_callback([sub, &args] {
     args.windows_given = sub->count("--windows") > 0;
@@ -73,9 +92,16 @@ int run_sweep(const SweepArgs& args) {
   if (!args.samples_given) cf.samples = base.cf.samples;
   if (!args.seed_given) cf.seed = base.cf.seed;
   const std::vector<int> cells = parse_cells_list(args.max_cells);
-  if (!args.plot.empty()) require_output(args.plot, "--plot", {".svg", ".png"});
-  if (!args.csv.empty()) require_output(args.csv, "--csv");
-  if (args.threads < 1) throw InputError("--threads " + std::to_string(args.threads) + " must be >= 1");
+  if (args.waypoints >= 2)
+    require_memory(args.waypoints * kBytesPerWaypoint, "--waypoints " + std::to_string(args.waypoints));
+  if (cf.windows >= 1)
+    require_memory(cf.windows * kBytesPerWindow, "CF windows " + std::to_string(cf.windows));
+  const std::vector<std::string> inputs = {args.cell, args.params};
+  if (!args.plot.empty()) require_output(args.plot, "--plot", {".svg", ".png"}, inputs);
+  if (!args.csv.empty()) require_output(args.csv, "--csv", {}, inputs);
+  if (!args.csv.empty() && !args.plot.empty() && std::filesystem::path(args.csv) == args.plot)
+    throw InputError("--csv and --plot name the same file " + args.csv);
+  require_threads(args.threads);
   const auto path = keyframe_path(scene, args.from, args.to, args.waypoints);
   // Issue #9: the nominal path is checked first; a sweep bounds the straight path only.
   if (const auto checked = check_path(scene, path); !checked.free()) {
@@ -92,12 +118,27 @@ int run_sweep(const SweepArgs& args) {
   }
   VolumeModel world(
       scene, *std::max_element(cells.begin(), cells.end()) + static_cast<int>(scene.obstacle_geoms().size()));
-  std::ostringstream md, csv;
+  // Rows are written as they finish (standard output and --csv, flushed), so that an interrupted
+  // sweep keeps the rows it finished.
+  std::ofstream csv;
+  if (!args.csv.empty()) {
+    csv.open(args.csv, std::ios::trunc);
+    if (!csv) throw InputError("--csv " + args.csv + ": cannot write the file");
+  }
+  auto flush_csv = [&] {
+    csv.flush();
+    if (!csv) throw InputError("--csv " + args.csv + ": writing the file failed");
+  };
+  std::ostream& md = std::cout;
   md << "| Max CBox | CBox | Computational Time [ms] | Confidence Factor [%] | 95 % CI [%] |"
         " worst window [%] | collapsed | mean width j1-j3 [rad] |\n"
      << "|---:|---:|---:|---:|---|---:|---:|---:|\n";
-  csv << "max_cells,boxes,time_ms,volume_ms,bounds_ms,checks,cf,ci_low,ci_high,worst_window_cf,collapsed,"
-         "mean_width\n";
+  md.flush();
+  if (csv.is_open()) {
+    csv << "max_cells,boxes,time_ms,volume_ms,bounds_ms,checks,cf,ci_low,ci_high,worst_window_cf,collapsed,"
+           "mean_width\n";
+    flush_csv();
+  }
   SweepSeries plotted{"leeway", {}};
   for (int c : cells) {
     Params p = base;
@@ -113,15 +154,17 @@ int run_sweep(const SweepArgs& args) {
        << run.ms_total() << " | " << std::setprecision(4) << 100 * r.cf << " | " << 100 * r.ci_low << " .. "
        << 100 * r.ci_high << " | " << 100 * r.worst_window_cf << " | " << collapsed << "/" << bisected
        << " | " << std::setprecision(3) << width << " |\n";
-    csv << c << "," << run.volume.boxes.size() << "," << std::setprecision(3) << run.ms_total() << ","
-        << run.ms_volume << "," << run.ms_bounds << "," << run.checks << "," << std::setprecision(6) << r.cf
-        << "," << r.ci_low << "," << r.ci_high << "," << r.worst_window_cf << "," << collapsed << "," << width
-        << "\n";
+    md.flush();
+    if (csv.is_open()) {
+      csv << c << "," << run.volume.boxes.size() << "," << std::setprecision(3) << run.ms_total() << ","
+          << run.ms_volume << "," << run.ms_bounds << "," << run.checks << "," << std::setprecision(6) << r.cf
+          << "," << r.ci_low << "," << r.ci_high << "," << r.worst_window_cf << "," << collapsed << ","
+          << width << "\n";
+      flush_csv();
+    }
     plotted.points.push_back({c, static_cast<double>(run.volume.boxes.size()), run.ms_total(), 100 * r.cf});
     std::cerr << "max_cells " << c << " done\n";
   }
-  std::cout << md.str();
-  if (!args.csv.empty()) write_file_atomic(args.csv, csv.str());
   if (!args.plot.empty()) write_sweep_plot(args.plot, args.cell, args.from, args.to, args.preset, plotted);
   return kExitOk;
 }

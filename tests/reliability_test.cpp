@@ -1,0 +1,266 @@
+// Issue 14's defects that the bad-input corpus (bad_input_test.cpp) cannot show from a command line:
+// the JSON reader's limits, output files and signals, thread creation failures, allocation
+// failures, MuJoCo warnings from worker threads, sweep rows and leeway-tune's log.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <new>
+#include <string>
+#include <thread>
+
+#include "cli/common.hpp"
+#include "json_io.hpp"
+#include "leeway/file_io.hpp"
+#include "leeway/kinematics.hpp"
+#include "leeway/mujoco_util.hpp"
+#include "leeway/scene.hpp"
+#include "parallel.hpp"
+#include "test_util.hpp"
+
+namespace leeway {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kCorpus = std::string(LEEWAY_TEST_DATA_DIR) + "/../bad_input";
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no InputError)";
+}
+
+// ------------------------------------------------------------------------------------ JSON input
+
+TEST(JsonInput, DeepNestingIsRefusedWithoutRecursion) {
+  const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+  EXPECT_NE(error_of([&] { detail::parse_json_text(deep, "deep.json"); }).find("nested deeper than 64"),
+            std::string::npos);
+  const std::string ok = std::string(64, '[') + std::string(64, ']');
+  EXPECT_NO_THROW(detail::parse_json_text(ok, "ok.json"));
+}
+
+TEST(JsonInput, DuplicateKeysAreRefusedNamingTheKey) {
+  EXPECT_EQ(error_of([] { detail::parse_json_text(R"({"a": {"b": 1, "b": 2}})", "f.json"); }),
+            "f.json: JSON key 'b' appears twice in one object");
+  // The same key in two objects is fine.
+  EXPECT_NO_THROW(
+      detail::parse_json_text(R"({"a": {"b": 1}, "c": {"b": 2}, "d": [{"b": 1}, {"b": 2}]})", "f"));
+}
+
+TEST(JsonInput, NumbersBeyondDoubleAreRefused) {
+  EXPECT_NE(
+      error_of([] {
+        detail::parse_json_text(R"({"volume": {"h_max": 1e400}})", "p.json");
+      }).find("p.json: malformed JSON: [json.exception.out_of_range.406] number overflow parsing '1e400'"),
+      std::string::npos);
+  EXPECT_NE(error_of([] { read_params(kCorpus + "/params/overflow.json"); }).find("overflow.json"),
+            std::string::npos);
+}
+
+TEST(JsonInput, FoldersAndFifosAreRefusedBeforeOpening) {
+  test::TempDir dir;
+  EXPECT_EQ(error_of([&] { detail::read_json_file(dir.path().string(), "bounds file"); }),
+            dir.path().string() + ": the bounds file is a folder, not a regular file");
+  const std::string fifo = (dir.path() / "f.json").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_EQ(error_of([&] { detail::read_json_file(fifo, "path file"); }),
+            fifo + ": the path file is a FIFO (named pipe), not a regular file");  // and no hang
+  EXPECT_EQ(error_of([&] { load_model_file(fifo); }),
+            fifo + ": the file is a FIFO (named pipe), not a regular file");
+}
+
+// ---------------------------------------------------------------------------------- output files
+
+TEST(OutputFiles, NonRegularTargetsAndInputsAreRefused) {
+  test::TempDir dir;
+  EXPECT_NE(error_of([] { write_file_atomic("/dev/null", "x"); }).find("is a device, not a regular file"),
+            std::string::npos);
+  EXPECT_TRUE(fs::is_character_file("/dev/null"));
+  const std::string input = dir.write("cell.xml", "<mujoco/>");
+  EXPECT_NE(error_of([&] {
+              require_regular_output((dir.path() / "." / "cell.xml").string(), {input});
+            }).find("is the input file"),
+            std::string::npos);
+  EXPECT_NO_THROW(require_regular_output((dir.path() / "new.json").string(), {input}));
+  EXPECT_EQ(error_of([] { require_regular_output(""); }), "the output file name is empty");
+}
+
+TEST(OutputFiles, WriteFileAtomicReplacesAndLeavesNoTemporary) {
+  test::TempDir dir;
+  const std::string path = (dir.path() / "out.json").string();
+  write_file_atomic(path, "one");
+  write_file_atomic(path, "two");
+  EXPECT_EQ(read_text(path), "two");
+  int files = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir.path())) ++files;
+  EXPECT_EQ(files, 1);
+}
+
+// A process ended by SIGTERM while write_file_atomic is under way leaves no .NAME.tmpPID behind.
+// The temporary file is made a FIFO first, so that the child blocks in open() with it registered.
+TEST(OutputFiles, SigtermRemovesTheTemporaryFile) {
+  test::TempDir dir;
+  const std::string target = (dir.path() / "out.json").string();
+  int sync[2];
+  ASSERT_EQ(::pipe(sync), 0);
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    install_temp_file_cleanup();
+    char go = 0;
+    if (::read(sync[0], &go, 1) != 1) ::_exit(3);
+    try {
+      write_file_atomic(target, "text");
+    } catch (...) {
+      ::_exit(4);
+    }
+    ::_exit(5);
+  }
+  const std::string tmp = (dir.path() / (".out.json.tmp" + std::to_string(child))).string();
+  ASSERT_EQ(::mkfifo(tmp.c_str(), 0600), 0);
+  ASSERT_EQ(::write(sync[1], "g", 1), 1);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  ASSERT_TRUE(fs::exists(tmp));
+  ::kill(child, SIGTERM);
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << status;
+  EXPECT_FALSE(fs::exists(tmp));
+  EXPECT_FALSE(fs::exists(target));
+  ::close(sync[0]);
+  ::close(sync[1]);
+}
+
+// ------------------------------------------------------------------------- threads and memory
+
+// Under an address-space limit that leaves no room for more thread stacks, parallel_for runs every
+// item on the threads it could create instead of terminating the process.
+TEST(Threads, CreationFailureFallsBackToFewerThreads) {
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    long pages = 0;
+    std::ifstream("/proc/self/statm") >> pages;
+    const rlim_t limit =
+        static_cast<rlim_t>(pages) * static_cast<rlim_t>(::sysconf(_SC_PAGESIZE)) + (64u << 20);
+    const rlimit rl{limit, limit};
+    if (::setrlimit(RLIMIT_AS, &rl) != 0) ::_exit(3);
+    std::atomic<int> done{0};
+    try {
+      detail::parallel_for(1000, 64, [&] { return [&](int) { ++done; }; });
+    } catch (...) {
+      ::_exit(4);
+    }
+    ::_exit(done == 1000 ? 0 : 5);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status)) << "the child was killed by signal " << WTERMSIG(status);
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+}
+
+TEST(Errors, AllocationFailureIsExit2WithAMessage) {
+  testing::internal::CaptureStderr();
+  const int code = cli::run_reporting_errors("leeway", []() -> int { throw std::bad_alloc(); });
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(code, kExitBadInput);
+  EXPECT_NE(err.find("leeway: error: out of memory"), std::string::npos) << err;
+  EXPECT_EQ(err.find("internal error"), std::string::npos) << err;
+}
+
+// ------------------------------------------------------------------------------ MuJoCo warnings
+
+std::atomic<int> g_warnings{0};
+void count_warning(const char*) { ++g_warnings; }
+
+// MuJoCo formats warning text in one process-wide buffer: a full contact buffer in mj_collision on
+// two worker threads at once was a data race. No warning may fire from a collision check.
+TEST(MujocoWarnings, NoneFromCollisionChecksOnTwoThreads) {
+  install_mujoco_error_handlers();
+  SceneOptions options;
+  options.checker = CollisionChecker::kMujoco;  // mj_collision itself, with nconmax="1"
+  const Scene scene = Scene::load(kCorpus + "/cells/full_contacts.xml", options);
+  auto* const saved = mju_user_warning;
+  g_warnings = 0;
+  mju_user_warning = count_warning;
+  std::atomic<int> hits{0};
+  auto work = [&] {
+    RobotState state(scene);
+    for (int i = 0; i < 200; ++i) {
+      Eigen::VectorXd q(1);
+      q << 0.001 * i;
+      hits += state.in_collision(q) ? 1 : 0;
+    }
+  };
+  std::thread a(work), b(work);
+  a.join();
+  b.join();
+  mju_user_warning = saved;
+  EXPECT_EQ(hits, 400);  // a full contact buffer still answers "in collision"
+  EXPECT_EQ(g_warnings, 0);
+}
+
+// --------------------------------------------------------------------------- programs end to end
+
+TEST(Sweep, CsvRowsAreWrittenAsTheyFinish) {
+  test::TempDir dir;
+  const std::string csv = (dir.path() / "t.csv").string();
+  const auto r = test::run_cli("sweep " + kCorpus + "/cells/ok.xml --from a --to b --max-cells 100,200" +
+                               " --windows 2 --samples 5 --threads 1 --csv " + csv);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const std::string text = read_text(csv);
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 3) << text;
+  EXPECT_EQ(text.rfind("max_cells,", 0), 0u) << text;
+}
+
+TEST(Mjb, CellsWorkInCheckAndBounds) {
+  test::TempDir dir;
+  const std::string mjb = (dir.path() / "ok.mjb").string();
+  {
+    const ModelPtr m = load_model_file(kCorpus + "/cells/ok.xml");
+    mj_saveModel(m.get(), mjb.c_str(), nullptr, 0);
+  }
+  const auto check = test::run_cli("check " + mjb);
+  EXPECT_EQ(check.exit_code, 0) << check.out;
+  const auto bounds = test::run_cli("bounds " + mjb + " --from a --to b --threads 2");
+  EXPECT_EQ(bounds.exit_code, 0) << bounds.out;
+}
+
+// SIGINT during leeway-tune's calibration keeps an existing --log as it was.
+TEST(Tune, InterruptedCalibrationKeepsTheLog) {
+  test::TempDir dir;
+  const std::string tune = (fs::path(LEEWAY_CLI).parent_path() / "leeway-tune").string();
+  const std::string log = dir.write("log.csv", "an earlier run's rows\n");
+  const std::string script = dir.write(
+      "run.sh", "cd " + dir.path().string() + "\n" + tune + " --case " + test::workcell("dallara") +
+                    ":home:patch --budget-evals 1 --log log.csv --out tuned.json 2>err.txt &\n"
+                    "pid=$!\n"
+                    "for i in $(seq 1 600); do grep -q calibrating err.txt && break; sleep 0.05; done\n"
+                    "kill -INT $pid\nwait $pid\necho \"exit=$?\"\ncat err.txt\n");
+  const auto r = test::run_program("sh", script);
+  if (r.out.find("interrupted before the first evaluation") == std::string::npos)
+    GTEST_SKIP() << "the calibration ended before the signal:\n" << r.out;
+  EXPECT_NE(r.out.find("exit=130"), std::string::npos) << r.out;
+  EXPECT_EQ(read_text(log), "an earlier run's rows\n");
+  EXPECT_FALSE(fs::exists(dir.path() / "tuned.json"));
+}
+
+}  // namespace
+}  // namespace leeway

@@ -21,6 +21,7 @@
 #include "leeway/pipeline.hpp"
 #include "leeway/planner.hpp"
 #include "leeway/tuning.hpp"
+#include "mjcf_text.hpp"
 
 namespace leeway {
 namespace {
@@ -202,37 +203,7 @@ std::string label_of(const json& given) {
 
 }  // namespace
 
-std::string xml_escape(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&apos;";
-        break;
-      case '\n':
-      case '\t':
-      case '\r':
-        out += c;
-        break;
-      default:
-        // XML 1.0 allows no other control characters, not even as references.
-        out += static_cast<unsigned char>(c) < 0x20 ? '?' : c;
-    }
-  }
-  return out;
-}
+std::string xml_escape(const std::string& text) { return detail::xml_escape(text); }
 
 Suite read_suite(const std::string& file) {
   const json j = detail::read_json_file(file, "suite");

@@ -1,6 +1,6 @@
 #pragma once
-// Internal: writing MJCF text (numbers that read back exactly, XML escapes), shared by the URDF
-// importer and the cell template (not part of the public API).
+// Internal: writing MJCF and XML text (numbers that read back exactly, XML escapes), shared by the
+// URDF importer, the cell template, the plots and the JUnit report (not part of the public API).
 
 #include <cmath>
 #include <cstdlib>
@@ -26,20 +26,36 @@ inline std::string exact_number(double v) {
   return text;
 }
 
-//! `s` with &, <, > and " escaped for an XML attribute.
-inline std::string xml_escape(const std::string& s) {
+//! `text` escaped for XML attributes and character data: &, <, >, " and ' as entities; tab, line
+//! feed and carriage return kept; other control characters (which XML 1.0 does not allow, not even
+//! as references) replaced by '?'.
+inline std::string xml_escape(const std::string& text) {
   std::string out;
-  for (char c : s) {
-    if (c == '&')
-      out += "&amp;";
-    else if (c == '<')
-      out += "&lt;";
-    else if (c == '>')
-      out += "&gt;";
-    else if (c == '"')
-      out += "&quot;";
-    else
-      out += c;
+  for (const char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
+      case '\n':
+      case '\t':
+      case '\r':
+        out += c;
+        break;
+      default:
+        out += static_cast<unsigned char>(c) < 0x20 ? '?' : c;
+    }
   }
   return out;
 }

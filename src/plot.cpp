@@ -14,6 +14,7 @@
 #include "leeway/bounds_file.hpp"
 #include "leeway/error.hpp"
 #include "leeway/mujoco_util.hpp"
+#include "mjcf_text.hpp"
 #include "offscreen.hpp"
 
 namespace leeway {
@@ -44,28 +45,7 @@ std::string tick_label(double v) {
   return buf;
 }
 
-std::string escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
+std::string escape(const std::string& s) { return detail::xml_escape(s); }
 
 // About `n` ticks at 1, 2 or 5 times a power of ten within [lo, hi].
 std::vector<double> nice_ticks(double lo, double hi, int n) {

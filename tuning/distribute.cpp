@@ -10,29 +10,12 @@
 namespace leeway::tune_cli {
 namespace {
 
-json eval_to_json(const CaseEval& e) {
-  return {{"cf", e.cf},
-          {"ci_low", e.ci_low},
-          {"ci_high", e.ci_high},
-          {"wall_ms", e.wall_ms},
-          {"cpu_ms", e.cpu_ms},
-          {"cost_ms", e.cost_ms},
-          {"checks", e.checks},
-          {"boxes", e.boxes},
-          {"near", e.near},
-          {"cells", e.cells},
-          {"bisected", e.bisected},
-          {"collapsed", e.collapsed},
-          {"mean_width", e.mean_width},
-          {"shortfall", e.shortfall},
-          {"score", e.score}};
-}
-
+// The reply: case_eval_json's record (problem.hpp), read back field by field.
 CaseEval eval_from_json(const json& j) {
   CaseEval e;
   e.cf = j.at("cf");
-  e.ci_low = j.at("ci_low");
-  e.ci_high = j.at("ci_high");
+  e.ci_low = j.at("ci95").at(0);
+  e.ci_high = j.at("ci95").at(1);
   e.wall_ms = j.at("wall_ms");
   e.cpu_ms = j.at("cpu_ms");
   e.cost_ms = j.at("cost_ms");
@@ -63,8 +46,8 @@ dist::Handler case_handler(Problem& pb) {
     if (k >= pb.cases.size())
       throw std::runtime_error("case " + std::to_string(k) + " of " + std::to_string(pb.cases.size()));
     const Options& o = pb.o;
-    return eval_to_json(leeway::evaluate_case(*pb.cases[k], pb.params(k, x), o.cf, o.repeats, o.threads,
-                                              model, o.objective))
+    return case_eval_json(leeway::evaluate_case(*pb.cases[k], pb.params(k, x), o.cf, o.repeats, o.threads,
+                                                model, o.objective))
         .dump();
   };
 }

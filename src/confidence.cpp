@@ -32,6 +32,25 @@ std::pair<double, double> wilson_interval(long successes, long n) {
   return {low, high};
 }
 
+PathTiming time_path(const Scene& scene, const std::vector<WaypointBounds>& bounds) {
+  PathTiming t;
+  t.timed = bounds.size() >= 2;
+  for (const auto& j : scene.joints()) t.timed = t.timed && j.max_speed > 0;
+  t.segment_start.push_back(0.0);
+  for (size_t i = 1; i < bounds.size(); ++i) {
+    double d = 0;
+    for (int j = 0; j < scene.dof(); ++j) {
+      const double step = std::abs(bounds[i].q[j] - bounds[i - 1].q[j]);
+      // Untimed (a joint without a speed): every segment lasts 1, the path parameter's own step.
+      d = t.timed ? std::max(d, step / scene.joints()[static_cast<size_t>(j)].max_speed) : 1.0;
+    }
+    t.segment.push_back(d);
+    t.total += d;
+    t.segment_start.push_back(t.total);
+  }
+  return t;
+}
+
 CfResult confidence_factor(const Scene& scene, const std::vector<WaypointBounds>& bounds,
                            const CfParams& params, int threads) {
   if (params.windows < 1) throw InputError("CF windows " + std::to_string(params.windows) + " must be >= 1");
@@ -44,6 +63,14 @@ CfResult confidence_factor(const Scene& scene, const std::vector<WaypointBounds>
       throw InputError("bounds of waypoint " + std::to_string(i) + " are not finite or have lower > upper");
   }
   const int segments = std::max<int>(1, static_cast<int>(bounds.size()) - 1);
+  const PathTiming timing = time_path(scene, bounds);
+  // Cumulative share of the path's duration at the start of every segment (and 1 at its end).
+  std::vector<double> start(static_cast<size_t>(segments) + 1, 1.0);
+  start[0] = 0.0;
+  for (int i = 1; i < segments; ++i)
+    start[static_cast<size_t>(i)] = timing.total > 0
+                                        ? timing.segment_start[static_cast<size_t>(i)] / timing.total
+                                        : static_cast<double>(i) / segments;
   std::vector<long> free_count(static_cast<size_t>(params.windows), 0);
   detail::parallel_for(params.windows, threads, [&] {
     // One RobotState (one mjData) per thread.
@@ -53,10 +80,16 @@ CfResult confidence_factor(const Scene& scene, const std::vector<WaypointBounds>
       Eigen::VectorXd q(scene.dof());
       long ok = 0;
       for (int k = 0; k < params.samples; ++k) {
-        // Path parameter s in window w, then the segment and the position in it.
-        const double s = (w + unit(rng)) * segments / params.windows;
-        const int seg = std::min(segments - 1, static_cast<int>(s));
-        const double t = bounds.size() == 1 ? 0.0 : s - seg;
+        // A moment in window w (as a share of the path's duration), then its segment (the last
+        // one starting at or before it: a segment of zero duration is never drawn) and the
+        // position in it.
+        const double s = (w + unit(rng)) / params.windows;
+        const int seg = std::max(
+            0, static_cast<int>(std::upper_bound(start.begin(), start.end() - 1, s) - start.begin()) - 1);
+        const double span = start[static_cast<size_t>(seg) + 1] - start[static_cast<size_t>(seg)];
+        const double t = bounds.size() == 1 || span <= 0
+                             ? 0.0
+                             : std::min(1.0, (s - start[static_cast<size_t>(seg)]) / span);
         const WaypointBounds& a = bounds[static_cast<size_t>(seg)];
         const WaypointBounds& b = bounds[std::min(bounds.size() - 1, static_cast<size_t>(seg) + 1)];
         detail::draw_in_segment(a.lower, a.upper, b.lower, b.upper, t, rng, q);
@@ -67,6 +100,8 @@ CfResult confidence_factor(const Scene& scene, const std::vector<WaypointBounds>
   });
 
   CfResult r;
+  r.duration = timing.total;
+  r.timed = timing.timed;
   long total_free = 0;
   r.worst_window_cf = 2;
   for (int w = 0; w < params.windows; ++w) {

@@ -219,5 +219,55 @@ TEST_F(ConfidenceTest, RejectsBadInputs) {
   EXPECT_THROW(confidence_factor(scene, {ok[0], nan_bound}, p, 1), InputError);
 }
 
+TEST_F(ConfidenceTest, SegmentsAreTimedByTheSlowestJoint) {
+  // The one-link arm's j1 has user[0] = 1.5 rad/s: segments of 0.3, 0 and 0.6 rad last 0.2, 0 and
+  // 0.4 s.
+  const Scene scene = load("");
+  const std::vector<WaypointBounds> b = {one_joint(0, -0.1, 0.1), one_joint(0.3, 0.2, 0.4),
+                                         one_joint(0.3, 0.2, 0.4), one_joint(-0.3, -0.4, -0.2)};
+  const PathTiming t = time_path(scene, b);
+  ASSERT_TRUE(t.timed);
+  ASSERT_EQ(t.segment.size(), 3u);
+  EXPECT_NEAR(t.segment[0], 0.2, 1e-15);
+  EXPECT_EQ(t.segment[1], 0.0);
+  EXPECT_NEAR(t.segment[2], 0.4, 1e-15);
+  EXPECT_NEAR(t.total, 0.6, 1e-15);
+  // The IRB 6700 (docs/mjcf-conventions.md speeds: j1 1.9199, j6 3.6652 rad/s): j1 0.5 rad and j6
+  // 1.0 rad take 0.2604 s and 0.2728 s; j6 sets the segment's duration.
+  const Scene dallara = Scene::load(test::workcell("dallara"));
+  Eigen::VectorXd q1 = Eigen::VectorXd::Zero(6);
+  q1[0] = 0.5;
+  q1[5] = 1.0;
+  const WaypointBounds a(Eigen::VectorXd::Zero(6), Eigen::VectorXd::Zero(6), Eigen::VectorXd::Zero(6));
+  const WaypointBounds c(q1, q1, q1);
+  EXPECT_NEAR(time_path(dallara, {a, c}).total, 1.0 / 3.6652, 1e-12);
+}
+
+TEST_F(ConfidenceTest, HowThePathIsSampledDoesNotChangeTheCf) {
+  // The same geometry and bounds as two, three (a duplicated end) and three (a midpoint) waypoints:
+  // a duplicated waypoint is a segment of zero duration and draws nothing, so the CF is the same
+  // sample for sample; a midpoint splits the time evenly, so the draws are the same up to the
+  // rounding of the interpolation. (With windows of equal path parameter the duplicated end took a
+  // third of the samples at one pose.)
+  const Scene scene = load(kWall);
+  const WaypointBounds a = one_joint(0, -0.5, 0.7), b = one_joint(0.4, 0.1, 1.2);
+  const WaypointBounds mid = one_joint(0.2, -0.2, 0.95);
+  CfParams p;
+  p.windows = 10;
+  p.samples = 2000;
+  const CfResult two = confidence_factor(scene, {a, b}, p, 2);
+  const CfResult dup_end = confidence_factor(scene, {a, b, b}, p, 2);
+  const CfResult dup_start = confidence_factor(scene, {a, a, b}, p, 2);
+  const CfResult split = confidence_factor(scene, {a, mid, b}, p, 2);
+  EXPECT_GT(two.collisions, 1000);  // not vacuous: the wall is within the bounds
+  EXPECT_LT(two.collisions, 19000);
+  EXPECT_EQ(dup_end.collisions, two.collisions);
+  EXPECT_EQ(dup_end.window_cf, two.window_cf);
+  EXPECT_EQ(dup_start.collisions, two.collisions);
+  EXPECT_NEAR(split.cf, two.cf, 1e-3);
+  EXPECT_TRUE(two.timed);
+  EXPECT_NEAR(two.duration, 0.4 / 1.5, 1e-15);
+}
+
 }  // namespace
 }  // namespace leeway

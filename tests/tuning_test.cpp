@@ -413,10 +413,12 @@ TEST_F(TuningTest, TheLoopImprovesOnTheStartTowardsTheKnownOptimum) {
   for (const char* v : {"d_t_lb=0.35", "d_t_ub=1.5", "d_g_lb=0.1", "d_g_ub=2", "d_ng_ub=0.5", "h_max=1.5",
                         "alpha_t=1", "alpha_g=1", "alpha_ng=1", "trail_margin=0"})
     fix += std::string(" --fix ") + v;
-  // lambda 1e5: with the midphase a run costs ~0.1 ms per 100 cells less than before (issue 10), so the
-  // time term needs this weight to make the small maps the optimum, as it was at 1e4 with mj_collision.
-  const auto r = run_tune(quick("--lambda 100000 --min-width 0 --budget-evals 15 --recheck 2 --log " +
-                                path("log.csv") + " --out " + path("t.json") + fix));
+  // A given time proxy (1 us per check and box), so that the objective does not depend on how busy
+  // the machine is: the smallest maps are then the optimum.
+  const auto r =
+      run_tune(quick("--lambda 10000 --time-model 0,0,0.001,0 --min-width 0 --budget-evals 15 "
+                     "--recheck 2 --log " +
+                     path("log.csv") + " --out " + path("t.json") + fix));
   ASSERT_EQ(r.exit_code, 0) << r.out;
   const auto objective = column(read_text(path("log.csv")), "objective");
   ASSERT_EQ(objective.size(), 15u);
@@ -428,6 +430,18 @@ TEST_F(TuningTest, TheLoopImprovesOnTheStartTowardsTheKnownOptimum) {
   EXPECT_THAT(r.out, HasSubstr("before / after"));
   EXPECT_THAT(r.out, HasSubstr("| cell:a:b | tuned |"));
   EXPECT_THAT(r.out, HasSubstr("recheck 1: search J"));
+}
+
+TEST_F(TuningTest, AGivenTimeModelSkipsTheCalibration) {
+  const auto r = run_tune(quick("--time-model 1,0.01,0.001,0 --budget-evals 3 --no-summary"));
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_THAT(r.out, HasSubstr("time proxy [ms] given: 1,0.01,0.001,0"));
+  EXPECT_THAT(r.out, Not(HasSubstr("calibrating")));
+  for (const char* bad : {"1,2,3", "1,2,3,-1", "1,2,nan,4"}) {
+    const auto b = run_tune(quick(std::string("--time-model ") + bad + " --budget-evals 3"));
+    EXPECT_EQ(b.exit_code, 2) << bad;
+    EXPECT_THAT(b.out, HasSubstr("--time-model")) << bad;
+  }
 }
 
 TEST_F(TuningTest, ABudgetOfNEvaluationsStopsAfterN) {

@@ -17,6 +17,26 @@ constexpr int kCalibrationRandomPoints = 24;
 // at 5 MAX_cells spread log-evenly over the range on the first case, plus random points of the
 // search box spread over the cases, so that checks, boxes and cells vary independently.
 bool calibrate(Problem& pb) {
+  if (!pb.o.time_model.empty()) {
+    // Given coefficients (a calibration of an earlier run, or a test's): the objective no longer
+    // depends on this machine's timings.
+    const Eigen::VectorXd c = leeway::parse_vector(pb.o.time_model, "--time-model");
+    if (c.size() != 4 || !c.allFinite() || (c.array() < 0).any())
+      throw leeway::InputError("--time-model '" + pb.o.time_model +
+                               "' must be four finite coefficients >= 0 [ms]: fixed, per check, per check "
+                               "and box, per check and near pair");
+    pb.model.ms_fixed = c[0];
+    pb.model.ms_per_check = c[1];
+    pb.model.ms_per_check_box = c[2];
+    pb.model.ms_per_check_near = c[3];
+    pb.report["time_model"] = {{"ms_fixed", c[0]},
+                               {"ms_per_check", c[1]},
+                               {"ms_per_check_box", c[2]},
+                               {"ms_per_check_near", c[3]},
+                               {"given", true}};
+    std::cerr << "time proxy [ms] given: " << pb.o.time_model << "\n";
+    return true;
+  }
   const double lo = pb.lower(kCellsIndex);
   const double hi = pb.upper(kCellsIndex);
   std::vector<std::pair<size_t, std::vector<double>>> points;

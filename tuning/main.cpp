@@ -89,6 +89,9 @@ int main(int argc, char** argv) {
   app.add_option("--time", o.time, "Time in the objective: calibrated proxy, or measured wall or CPU time")
       ->check(CLI::IsMember({"proxy", "wall", "cpu"}))
       ->capture_default_str();
+  app.add_option("--time-model", o.time_model,
+                 "The proxy's coefficients A,B,C,D [ms] (fixed, per check, per check and box, per check and "
+                 "near pair) instead of calibrating them: reproducible objectives across machines");
   app.add_option("--repeats", o.repeats,
                  "Runs per evaluation whose median is the time (default: 1 proxy, 3 else)");
   app.add_option("--cf-windows", o.cf.windows, "CF windows")->capture_default_str();

@@ -59,6 +59,7 @@ struct Options {
   int population = 0, repeats = 0, threads = 1, waypoints = 2, final_samples = 10000, final_repeats = 3,
       recheck = 0, noise_study = 0;
   std::string noise_center;
+  std::string time_model;  //!< --time-model A,B,C,D: the proxy's coefficients [ms], no calibration
   double noise_radius = 0.05;
   std::uint64_t final_seed = 2;
   bool no_summary = false;

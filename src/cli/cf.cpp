@@ -39,14 +39,25 @@ int run_cf(const CfArgs& args) {
                           {"samples", r.samples},
                           {"collisions", r.collisions},
                           {"windows", args.params.windows},
+                          {"windows_by", r.timed ? "time" : "path parameter"},
+                          {"duration", r.duration},
                           {"seed", args.params.seed},
-                          {"units", "cf and ci95 are fractions (1 = 100 %)"}};
+                          {"units",
+                           "cf and ci95 are fractions (1 = 100 %); duration in seconds when windows_by "
+                           "is time, else in segments"}};
     std::cout << out.dump(2) << "\n";
   } else {
     std::cout << std::fixed << std::setprecision(4) << "CF " << 100 * r.cf << " % (95 % CI " << 100 * r.ci_low
               << " .. " << 100 * r.ci_high << " %), " << r.collisions << " of " << r.samples
               << " samples collide; worst window " << r.worst_window << " of " << args.params.windows << ": "
               << 100 * r.worst_window_cf << " %\n";
+    if (r.timed)
+      std::cout << std::setprecision(3) << "windows: " << args.params.windows << " of equal duration, "
+                << r.duration / args.params.windows
+                << " s each (the path timed by the joints' nominal speeds: " << r.duration << " s)\n";
+    else
+      std::cout << "windows: " << args.params.windows
+                << " of equal path parameter (a joint has no nominal speed, so the path is not timed)\n";
   }
   return kExitOk;
 }

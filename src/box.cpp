@@ -98,7 +98,7 @@ double box_distance(const Box& a, const Box& b, Eigen::Vector3d* on_a, Eigen::Ve
   // vertex against the other box and every edge pair covers both cases.
   const auto ca = box_corners(a), cb = box_corners(b);
   double best = std::numeric_limits<double>::infinity();
-  Eigen::Vector3d best_a, best_b;
+  Eigen::Vector3d best_a = a.center, best_b = b.center;
   auto consider = [&](const Eigen::Vector3d& pa, const Eigen::Vector3d& pb) {
     const double d = (pa - pb).squaredNorm();
     if (d < best) {

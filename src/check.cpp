@@ -1,5 +1,6 @@
 #include "leeway/check.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -93,8 +94,23 @@ CheckReport check_scene(const Scene& scene, const CheckOptions& options) {
                                 scene.geom_label(b) + "' overlap by " + format_number(depth) + " m");
     }
   };
-  for (size_t i = 0; i < obstacles.size(); ++i)
-    for (size_t j = i + 1; j < obstacles.size(); ++j) add_overlap(obstacles[i], obstacles[j], "obstacles");
+  // Pairs in index order, as a double loop would visit them, but only those whose world AABBs meet
+  // (a pair that overlaps by more than the tolerance >= 0 must): the midphase's grid keeps this
+  // linear in the obstacles instead of quadratic.
+  std::vector<Aabb> aabbs;
+  for (int g : obstacles) aabbs.push_back(geom_aabb(m, *rest, g));
+  AabbGrid grid;
+  grid.build(aabbs);
+  std::vector<int> near;
+  for (size_t i = 0; i < obstacles.size(); ++i) {
+    near.clear();
+    grid.any(aabbs[i], [&](int j) {
+      if (static_cast<size_t>(j) > i) near.push_back(j);
+      return false;
+    });
+    std::sort(near.begin(), near.end());
+    for (int j : near) add_overlap(obstacles[i], obstacles[static_cast<size_t>(j)], "obstacles");
+  }
   for (int o : obstacles)
     for (int b : scene.base_geoms()) add_overlap(o, b, "obstacle and robot base");
 

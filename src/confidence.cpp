@@ -38,12 +38,11 @@ PathTiming time_path(const Scene& scene, const std::vector<WaypointBounds>& boun
   for (const auto& j : scene.joints()) t.timed = t.timed && j.max_speed > 0;
   t.segment_start.push_back(0.0);
   for (size_t i = 1; i < bounds.size(); ++i) {
-    double d = 0;
-    for (int j = 0; j < scene.dof(); ++j) {
-      const double step = std::abs(bounds[i].q[j] - bounds[i - 1].q[j]);
-      // Untimed (a joint without a speed): every segment lasts 1, the path parameter's own step.
-      d = t.timed ? std::max(d, step / scene.joints()[static_cast<size_t>(j)].max_speed) : 1.0;
-    }
+    // Untimed (a joint without a speed): every segment lasts 1, the path parameter's own step.
+    double d = t.timed ? 0.0 : 1.0;
+    for (int j = 0; t.timed && j < scene.dof(); ++j)
+      d = std::max(d, std::abs(bounds[i].q[j] - bounds[i - 1].q[j]) /
+                          scene.joints()[static_cast<size_t>(j)].max_speed);
     t.segment.push_back(d);
     t.total += d;
     t.segment_start.push_back(t.total);

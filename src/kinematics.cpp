@@ -63,7 +63,7 @@ void RobotState::run_collision() {
 bool RobotState::in_collision(const Eigen::VectorXd& q) {
   set(q);
   const mjModel& m = scene_->model();
-  if (scene_->checker() == CollisionChecker::kMidphase && emulates_mj_collision(m))
+  if (scene_->checker() == CollisionChecker::kMidphase)
     return any_contact(m, *data_, scene_->link_geoms(), scene_->statics());
   run_collision();
   return data_->ncon > 0;

@@ -176,7 +176,9 @@ void Scene::recognise(const SceneOptions& options) {
                      "(contype or conaffinity must be non-zero)");
 
   // Sites: the tool site in the robot, goal sites outside it.
-  checker_ = options.checker;
+  // A model the midphase cannot answer for (explicit pairs, excludes, ...) is checked by MuJoCo's
+  // full pass: decided once here, not on every check.
+  checker_ = emulates_mj_collision(m) ? options.checker : CollisionChecker::kMujoco;
   tool_site_ = mj_name2id(&m, mjOBJ_SITE, options.tool_site.c_str());
   if (tool_site_ < 0)
     throw InputError(file + ": no site named '" + options.tool_site +

@@ -74,7 +74,8 @@ class Scene {
   std::string geom_label(int geom) const;
 
   int tool_site() const { return tool_site_; }
-  //! The collision checker chosen at load (SceneOptions::checker).
+  //! The collision checker: SceneOptions::checker, or kMujoco when the model needs mj_collision
+  //! (emulates_mj_collision() is false for it).
   CollisionChecker checker() const { return checker_; }
   //! Every geom that is not a link, indexed for the midphase at its (fixed) pose.
   const StaticGeoms& statics() const { return statics_; }

@@ -677,7 +677,9 @@ TEST_F(CertifyTest, BadBoundsThrowInputError) {
   const std::string needles[] = {"6 joint values", "6 joint values", "'j2'", "'j5'", "'j3'"};
   for (size_t k = 0; k < std::size(bad); ++k) {
     SCOPED_TRACE(needles[k]);
-    const auto& [l, u] = bad[k];
+    // Named references, not a structured binding: lambdas capture those only from C++20 (clang).
+    const Eigen::VectorXd& l = bad[k].first;
+    const Eigen::VectorXd& u = bad[k].second;
     expect_input_error([&] { certifier.region_free(l, u, stats); }, needles[k]);
     expect_input_error([&] { certifier.leaf_free(l, u, stats); }, needles[k]);
     expect_input_error([&] { certifier.segment_free(l, u, lo, hi, stats); }, needles[k]);

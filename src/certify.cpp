@@ -134,14 +134,18 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
                                std::vector<int>& pairs, CertifyStats& stats, CertifyFailure* failure,
                                const Eigen::VectorXd* blame) {
   ++stats.leaves;
-  const Eigen::VectorXd c = (lower + upper) / 2;
-  const Eigen::VectorXd h = (upper - lower) / 2;
+  // Scratch kept across calls (capacity only): a leaf allocates nothing once the first has run.
+  // One Certifier per thread and no recursion, so thread-local storage is enough.
+  thread_local Eigen::VectorXd c, h;
+  c = (lower + upper) / 2;
+  h = (upper - lower) / 2;
   state_.set(c);
   const mjModel& m = scene_->model();
   const mjData& d = state_.data();
   const double margin = options_.margin;
   const size_t nobs = obstacles_.size();
-  std::vector<int> failing;
+  thread_local std::vector<int> failing;
+  failing.clear();
   int last_link = -1;
   if (failure) {
     failure->centre_hits = false;
@@ -151,10 +155,10 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
   // Per link (computed when its first pair comes up): world box at c, joint Jacobian columns at the
   // box centre, derivatives of the box axes, and the remainders.
   Box box;
-  std::vector<Eigen::Vector3d> jac;       // d x / d q_i at c
-  std::vector<Eigen::Matrix3d> axis_jac;  // column k: d e_k / d q_i at c
-  std::vector<Eigen::Vector3d> axis;      // joint axes at c
-  std::vector<double> theta_before;       // rotation the hinges before each joint can give its axis
+  thread_local std::vector<Eigen::Vector3d> jac;       // d x / d q_i at c
+  thread_local std::vector<Eigen::Matrix3d> axis_jac;  // column k: d e_k / d q_i at c
+  thread_local std::vector<Eigen::Vector3d> axis;      // joint axes at c
+  thread_local std::vector<double> theta_before;  // rotation the hinges before each joint can give its axis
   // One second-order term (p, q) of the remainder, see below.
   struct Term {
     size_t p = 0;
@@ -163,12 +167,48 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
     Eigen::Vector3d w = Eigen::Vector3d::Zero();
     Eigen::Matrix3d we = Eigen::Matrix3d::Zero();
   };
-  std::vector<Term> terms;
+  thread_local std::vector<Term> terms;
   bool terms_ready = false;
-  std::vector<double> r_pos, r_rot;  // per joint p: the remainder terms (p, q >= p) with |n x a_p| = 1
-  std::function<void()> build_terms;
-  double iso = 0;           // radius of a sphere around x(c) holding the swept link
-  double lever_radius = 0;  // the loose reference's inflation
+  thread_local std::vector<double> r_pos,
+      r_rot;                            // per joint p: the remainder terms (p, q >= p) with |n x a_p| = 1
+  thread_local std::vector<double> dv;  // per joint q: |v_q(q) - v_q(c)|, see below
+  size_t link_n = 0;                    // the current link's joint count, ...
+  double link_theta = 0;                // ... the rotation all its hinges can give, ...
+  int link_index = 0;                   // ... and its index in links_
+  double iso = 0;                       // radius of a sphere around x(c) holding the swept link
+  double lever_radius = 0;              // the loose reference's inflation
+
+  auto build_terms = [&] {
+    const size_t n = link_n;
+    const double theta = link_theta;
+    const int li = link_index;
+    const Link& l = links_[static_cast<size_t>(li)];
+    terms.clear();
+    for (size_t p = 0; p < n; ++p) {
+      const int rp = l.joints[p];
+      if (prismatic_[static_cast<size_t>(rp)]) continue;
+      for (size_t q = p; q < n; ++q) {
+        const int rq = l.joints[q];
+        Term t;
+        t.p = p;
+        t.coef = (p == q ? 0.5 : 1.0) * h[rp] * h[rq];
+        if (t.coef == 0) continue;
+        const bool slide = prismatic_[static_cast<size_t>(rq)];
+        const Eigen::Vector3d anchor = vec3(d.xanchor + 3 * scene_->joints()[static_cast<size_t>(rq)].id);
+        t.w = slide ? Eigen::Vector3d(axis[p].cross(axis[q]))
+                    : Eigen::Vector3d(axis[p].cross(axis[q].cross(box.center - anchor)));
+        t.iso = slide ? 1.0 : l.lever[q];
+        t.var = t.iso * (theta_before[p] + theta_before[q]) + (slide ? 0.0 : dv[q]);
+        t.slide = slide;
+        if (!slide) {
+          for (int k = 0; k < 3; ++k) t.we.col(k) = axis[p].cross(axis[q].cross(box.rotation.col(k)));
+          t.var_e = theta_before[p] + theta_before[q] + theta;
+        }
+        terms.push_back(t);
+      }
+    }
+    terms_ready = true;
+  };
 
   for (int pair : pairs) {
     ++stats.pair_tests;
@@ -215,7 +255,7 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
       }
       const double theta = before;
       // |v_q(q) - v_q(c)| per q.
-      std::vector<double> dv(n, 0.0);
+      dv.assign(n, 0.0);
       for (size_t q = 0; q < n; ++q) {
         const int rq = link.joints[q];
         if (prismatic_[static_cast<size_t>(rq)]) continue;
@@ -243,34 +283,9 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
         rem_iso += r_pos[p];
       }
       terms_ready = false;
-      build_terms = [&, n, theta, dv, li] {
-        const Link& l = links_[static_cast<size_t>(li)];
-        terms.clear();
-        for (size_t p = 0; p < n; ++p) {
-          const int rp = l.joints[p];
-          if (prismatic_[static_cast<size_t>(rp)]) continue;
-          for (size_t q = p; q < n; ++q) {
-            const int rq = l.joints[q];
-            Term t;
-            t.p = p;
-            t.coef = (p == q ? 0.5 : 1.0) * h[rp] * h[rq];
-            if (t.coef == 0) continue;
-            const bool slide = prismatic_[static_cast<size_t>(rq)];
-            const Eigen::Vector3d anchor = vec3(d.xanchor + 3 * scene_->joints()[static_cast<size_t>(rq)].id);
-            t.w = slide ? Eigen::Vector3d(axis[p].cross(axis[q]))
-                        : Eigen::Vector3d(axis[p].cross(axis[q].cross(box.center - anchor)));
-            t.iso = slide ? 1.0 : l.lever[q];
-            t.var = t.iso * (theta_before[p] + theta_before[q]) + (slide ? 0.0 : dv[q]);
-            t.slide = slide;
-            if (!slide) {
-              for (int k = 0; k < 3; ++k) t.we.col(k) = axis[p].cross(axis[q].cross(box.rotation.col(k)));
-              t.var_e = theta_before[p] + theta_before[q] + theta;
-            }
-            terms.push_back(t);
-          }
-        }
-        terms_ready = true;
-      };
+      link_n = n;
+      link_theta = theta;
+      link_index = li;
       iso = rem_iso + box.half_size.norm();
       for (size_t p = 0; p < n; ++p) iso += h[link.joints[p]] * jac[p].norm();
     }
@@ -402,7 +417,7 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
     if (failure && !failure->centre_hits) failure->centre_hits = touches(box, margin, obs.box, obs.plane);
     failing.push_back(pair);
   }
-  pairs = std::move(failing);
+  pairs.swap(failing);
   return pairs.empty();
 }
 

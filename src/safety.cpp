@@ -166,13 +166,15 @@ SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& g
               (pass ? ok : bad) = extent;
             }
           }
-          // ... then the largest the certificate proves, between the shrunk value and that one
-          // (the probe's limit first).
+          // ... then the largest the certificate proves, between the shrunk value and that one:
+          // the probe's limit first, then an eighth of the way to it (when that small slab cannot
+          // be proven, the larger ones the bisection would try next are not either, almost always:
+          // a failing slab costs its whole leaf budget), then bisection.
           const double probe_limit = ok;
           ok = shrunk_to;
           bad = probe_limit;
           for (int step = 0; step < kRegrowSteps && bad - ok > kTinyExtent; ++step) {
-            extent = step == 0 ? bad : (ok + bad) / 2;
+            extent = step == 0 ? bad : step == 1 ? ok + (bad - ok) / 8 : (ok + bad) / 2;
             // Only what the growth adds needs proving: the rest was proven with extent `ok`.
             const bool pass = slab_certified(a, b, k, i, side, ok, extent) &&
                               (!previous || slab_certified(a - 1, a, k, i, side, ok, extent)) &&
@@ -182,6 +184,7 @@ SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& g
               if (step == 0) break;
             } else {
               bad = extent;
+              if (step == 1) break;
             }
           }
           extent = ok;

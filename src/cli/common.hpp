@@ -48,6 +48,15 @@ inline std::optional<int> parse_cli(CLI::App& app, int argc, char** argv, const 
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::string message = e.what();
+    // CLI11 checks required arguments before unknown ones: `leeway bounds --foo` would say "cell is
+    // required". An argument that no option takes is the more likely mistake: name it first.
+    if (dynamic_cast<const CLI::RequiredError*>(&e)) {
+      const std::vector<std::string> extra = app.remaining(true);
+      if (!extra.empty()) {
+        message = "The following argument" + std::string(extra.size() > 1 ? "s were" : " was") + " not expected:";
+        for (const auto& arg : extra) message += " " + arg;
+      }
+    }
     for (char& ch : message)
       if (ch == '\n' || ch == '\r') ch = ' ';
     while (!message.empty() && message.back() == ' ') message.pop_back();

@@ -225,11 +225,13 @@ class MotionValidator : public ob::MotionValidator {
       : ob::MotionValidator(si), checker_(std::move(checker)) {}
 
   bool checkMotion(const ob::State* s1, const ob::State* s2) const override {
+    ++motions_;
     return checker_->edge_free(checker_->to_q(s1), checker_->to_q(s2));
   }
 
   bool checkMotion(const ob::State* s1, const ob::State* s2,
                    std::pair<ob::State*, double>& last_valid) const override {
+    ++motions_;
     long last = 0, n = 1;
     if (checker_->edge_free_from(checker_->to_q(s1), checker_->to_q(s2), last, n)) return true;
     last_valid.second = static_cast<double>(last) / static_cast<double>(n);
@@ -240,6 +242,13 @@ class MotionValidator : public ob::MotionValidator {
 
  private:
   std::shared_ptr<Checker> checker_;
+
+ public:
+  //! Motions checked so far: an upper bound of the states RRT-Connect added to its trees.
+  long motions() const { return motions_.load(); }
+
+ private:
+  mutable std::atomic<long> motions_{0};
 };
 
 // OMPL's RNG instances draw their seeds from one process-wide sequence, and RNG::setSeed() may
@@ -299,6 +308,9 @@ void validate(const PlanOptions& o) {
   finite_positive(o.time_limit, "time_limit", 1e-3, 86400, "s");
   finite_positive(o.resolution, "resolution", 1e-5, 1.0, "rad");
   finite_positive(o.slide_resolution, "slide_resolution", 1e-5, 1.0, "m");
+  if (o.max_states < 16 || o.max_states > 16L * 1024 * 1024)
+    throw InputError("plan option 'max_states' = " + std::to_string(o.max_states) + " must be from 16 to " +
+                     std::to_string(16L * 1024 * 1024) + " (the memory limit of RRT-Connect's trees)");
   if (!(std::isfinite(o.range) && o.range >= 0))
     throw InputError("plan option 'range' = " + format_number(o.range) +
                      " rad must be a finite number >= 0 (0: OMPL's default)");
@@ -430,7 +442,8 @@ PlanResult plan_path(const Scene& scene, const Eigen::VectorXd& start, const Eig
   });
   auto si = std::make_shared<ob::SpaceInformation>(space);
   si->setStateValidityChecker(std::make_shared<ValidityChecker>(si, checker));
-  si->setMotionValidator(std::make_shared<MotionValidator>(si, checker));
+  auto motion_validator = std::make_shared<MotionValidator>(si, checker);
+  si->setMotionValidator(motion_validator);
   si->setup();
 
   ob::ScopedState<> s(space), g(space);
@@ -442,9 +455,20 @@ PlanResult plan_path(const Scene& scene, const Eigen::VectorXd& start, const Eig
   if (options.range > 0) planner->setRange(options.range / options.resolution);
   planner->setProblemDefinition(pdef);
   planner->setup();
-  const ob::PlannerStatus status = planner->solve(ob::timedPlannerTerminationCondition(options.time_limit));
+  const long max_states = options.max_states;
+  const ob::PlannerStatus status = planner->solve(ob::plannerOrTerminationCondition(
+      ob::timedPlannerTerminationCondition(options.time_limit),
+      ob::PlannerTerminationCondition([&] { return motion_validator->motions() >= max_states; })));
   result.method = "rrt_connect";
   result.plan_seconds = seconds_since(t0);
+  if (status != ob::PlannerStatus::EXACT_SOLUTION && motion_validator->motions() >= max_states) {
+    result.checks = checker->checks();
+    result.message = "no collision-free path from " + start_name + " to " + goal_name + " found in " +
+                     std::to_string(max_states) + " motions (seed " + std::to_string(options.seed) +
+                     "): planning stopped there to keep RRT-Connect's trees within their memory limit "
+                     "(about 200 bytes per state)";
+    return result;
+  }
   if (status != ob::PlannerStatus::EXACT_SOLUTION) {
     result.checks = checker->checks();
     result.message = "no collision-free path from " + start_name + " to " + goal_name +

@@ -301,6 +301,28 @@ TEST_F(PlannerTest, NoPathWithinTheTimeLimitIsAnOutcome) {
   EXPECT_LT(seconds, 1.0);
 }
 
+TEST_F(PlannerTest, TheTreesStopAtTheirStateLimitWhateverTheTimeLimit) {
+  // The same impossible problem with an hour to spend: the state limit (the memory guard) ends it
+  // after exactly max_states motion checks, each at least one collision check.
+  test::TempDir dir;
+  const Scene scene = Scene::load(
+      dir.write("cell.xml", one_link_cell(R"(<geom name="wall" type="box" size="1 0.05 1" pos="0 1 1"/>)")));
+  Eigen::VectorXd a(1), b(1);
+  a << 0.0;
+  b << 2.5;
+  PlanOptions o;
+  o.time_limit = 3600;
+  o.max_states = 200;
+  const PlanResult r = plan_path(scene, a, b, o, "start 'a'", "goal 'b'");
+  EXPECT_FALSE(r.success);
+  EXPECT_NE(r.message.find("no collision-free path from start 'a' to goal 'b' found in 200 motions"),
+            std::string::npos)
+      << r.message;
+  EXPECT_NE(r.message.find("memory limit"), std::string::npos) << r.message;
+  EXPECT_GE(r.checks, 200);
+  EXPECT_LT(r.plan_seconds, 60.0);
+}
+
 TEST_F(PlannerTest, RejectsBadOptions) {
   const Scene scene = Scene::load(workcell("dallara"));
   const Eigen::VectorXd a = scene.keyframe("home").q, b = scene.keyframe("patch").q;
@@ -329,6 +351,11 @@ TEST_F(PlannerTest, RejectsBadOptions) {
   o = {};
   o.range = -1;
   EXPECT_NE(message(o).find("plan option 'range' = -1 rad"), std::string::npos);
+  o = {};
+  o.max_states = 15;
+  EXPECT_NE(message(o).find("plan option 'max_states' = 15 must be from 16 to 16777216"), std::string::npos);
+  o.max_states = 16L * 1024 * 1024 + 1;
+  EXPECT_NE(message(o).find("plan option 'max_states' = 16777217"), std::string::npos);
   // The library names its options; the programs name their flags.
 }
 

@@ -40,6 +40,11 @@ struct PlanOptions {
   //! shortest path in the planner's metric, which RRT-Connect plus simplification would also end
   //! with). false: always run RRT-Connect.
   bool try_direct = true;
+  //! Memory guard: RRT-Connect stops (no path, a message saying why) after this many motion
+  //! checks, each of which may add one state to its trees. At about 200 bytes per state (OMPL's
+  //! motion, state and nearest-neighbour entry, our estimate) the default keeps the trees below
+  //! about 3.2 GiB however long the time limit is.
+  long max_states = 16L * 1024 * 1024;
 };
 
 //! Outcome of plan_path(). Not finding a path is an outcome, not an error.

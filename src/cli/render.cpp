@@ -128,6 +128,7 @@ int run_render(const RenderArgs& args) {
   } else if (with_path) {
     if (args.waypoints < 2)
       throw InputError("--waypoints " + std::to_string(args.waypoints) + " must be >= 2");
+    require_memory(args.waypoints * kBytesPerWaypoint, "--waypoints " + std::to_string(args.waypoints));
     if (args.waypoint >= args.waypoints)
       throw InputError("--waypoint " + std::to_string(args.waypoint) + ": the path has " +
                        std::to_string(args.waypoints) + " waypoints (0 .. " +

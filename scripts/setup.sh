@@ -5,6 +5,8 @@
 # libosmesa6-dev: offscreen OpenGL without a display for `leeway render` and PNG plots (MuJoCo links
 # no GL itself); zlib1g-dev: PNG compression. libopenmpi-dev, openmpi-bin: `leeway batch` and
 # leeway-tune over MPI ranks (optional for the build; the MPI tests run when mpirun is there).
+# `--sanitizers` adds what scripts/sanitize.sh needs: clang and its sanitizer/libFuzzer runtimes
+# (gcc's ASan/UBSan/TSan runtimes come with build-essential).
 set -euo pipefail
 
 packages=(
@@ -13,6 +15,15 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
   libosmesa6-dev zlib1g-dev libopenmpi-dev openmpi-bin
 )
+for arg in "$@"; do
+  case "$arg" in
+    --sanitizers) packages+=(clang libclang-rt-14-dev) ;;
+    *)
+      echo "setup: unknown option '$arg' (only --sanitizers)" >&2
+      exit 2
+      ;;
+  esac
+done
 
 missing=()
 for p in "${packages[@]}"; do

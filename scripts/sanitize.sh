@@ -1,0 +1,78 @@
+#!/usr/bin/env bash
+# Sanitizer and fuzzing jobs (docs/testing.md). CI runs `bash scripts/sanitize.sh all` after the
+# README's test command.
+#
+#   bash scripts/sanitize.sh address [BUILD_DIR]   clang build with ASan + UBSan (float casts too,
+#                                                 every finding fatal) and libFuzzer coverage; the
+#                                                 whole ctest suite, the fuzz corpora replayed
+#   bash scripts/sanitize.sh thread [BUILD_DIR]    gcc build with TSan; the tests that run threads
+#   bash scripts/sanitize.sh fuzz [BUILD_DIR]      each fuzz target for LEEWAY_FUZZ_SECONDS (60) s
+#                                                 on the address build
+#   bash scripts/sanitize.sh all                   the three in that order
+#
+# Default build directories: build-asan, build-tsan. Exit status: 0 clean; otherwise the failing
+# step's (a sanitizer report fails its test; the fuzzer's exit for a finding).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+job="${1:-all}"
+jobs="${LEEWAY_SANITIZE_JOBS:-$(nproc)}"
+
+# The tests that run work on several threads (bounds, CF, safety stage, sweep, planner, batch) and
+# the ones about threads themselves: TSan's share of the suite (the rest is single-threaded code
+# that ASan/UBSan already cover, and TSan slows everything ~10x).
+tsan_tests='Thread|thread|Concurrent|Deterministic|Parallel|Sweep|MujocoWarnings|Batch|Safety|Confidence'
+
+configure() {  # build_dir sanitizer compiler extra...
+  local dir="$1" sanitizer="$2" cc="$3" cxx="$4"
+  shift 4
+  cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER="$cc" \
+    -DCMAKE_CXX_COMPILER="$cxx" -DLEEWAY_SANITIZE="$sanitizer" -DLEEWAY_BUILD_BENCHMARKS=OFF \
+    -DLEEWAY_WITH_MPI=OFF -DLEEWAY_WARNINGS_AS_ERRORS=OFF "$@"
+}
+
+# Every sanitizer finding is fatal and named; leaks are findings too.
+export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0:halt_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1:check_initialization_order=1}"
+export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
+export TSAN_OPTIONS="${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1}"
+export LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$PWD/tests/sanitizers/lsan.supp:print_suppressions=0}"
+# The certificate's property tests sample 400-1,500 regions per cell; a tenth keeps every code path
+# and the sanitized suite within CI's time (tests/certify_test.cpp, property_count).
+export LEEWAY_CERTIFY_COUNT="${LEEWAY_CERTIFY_COUNT:-40}"
+
+run_address() {
+  local dir="${1:-build-asan}"
+  bash scripts/setup.sh --sanitizers
+  configure "$dir" address clang clang++ -DLEEWAY_BUILD_FUZZERS=ON
+  cmake --build "$dir" -j "$jobs"
+  ctest --test-dir "$dir" --output-on-failure -j "$jobs" --timeout 1500
+}
+
+run_thread() {
+  local dir="${1:-build-tsan}"
+  bash scripts/setup.sh --sanitizers
+  configure "$dir" thread gcc g++
+  cmake --build "$dir" -j "$jobs" --target leeway_tests leeway_cli leeway_tune
+  ctest --test-dir "$dir" --output-on-failure -j "$jobs" --timeout 1500 -R "$tsan_tests"
+}
+
+run_fuzz() {
+  local dir="${1:-build-asan}"
+  if [ ! -x "$dir/leeway-fuzz-cell" ]; then run_address "$dir"; fi
+  bash scripts/fuzz.sh "${LEEWAY_FUZZ_SECONDS:-60}" "$dir"
+}
+
+case "$job" in
+  address) run_address "${2:-}" ;;
+  thread) run_thread "${2:-}" ;;
+  fuzz) run_fuzz "${2:-}" ;;
+  all)
+    run_address
+    run_fuzz
+    run_thread
+    ;;
+  *)
+    echo "sanitize.sh: unknown job '$job' (address, thread, fuzz or all)" >&2
+    exit 2
+    ;;
+esac

@@ -1,0 +1,121 @@
+#!/usr/bin/env python3
+"""Scale benchmark of issue 14: leeway on inputs far larger than the thesis's.
+
+  1. `leeway bounds CELL --path P` on a joint-linear path file of N waypoints (default 1,000) at
+     default settings (leeway preset, certified safety stage, all hardware threads); target <= 30 s.
+  2. `leeway check` on a cell with 20,000 extra obstacles (4 x 4 x 20 cm boxes at seeded random
+     places over 8 x 8 m, overlaps included); target <= 5 s.
+
+Every input is generated into a temporary folder (nothing is written to the repository); each case
+runs --repeats times and the table gives the median wall time [s], the CPU time [s] and what the
+run reported. Usage: python3 tools/scale_bench.py [--build build] [--repeats 3] [--waypoints 1000]
+[--obstacles 20000]
+"""
+import argparse
+import json
+import os
+import pathlib
+import random
+import resource
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "tools"))
+from machine_info import machine  # noqa: E402
+
+
+def cpu_of_children():
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def timed(cmd, ok=(0,)):
+    c0, t0 = cpu_of_children(), time.monotonic()
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    wall, cpu = time.monotonic() - t0, cpu_of_children() - c0
+    if r.returncode not in ok:
+        sys.exit(f"scale_bench: {' '.join(map(str, cmd))} exited {r.returncode}: {r.stderr.strip()[-400:]}")
+    return wall, cpu, r.stdout
+
+
+def ends(cell, a, b):
+    """The joint names and the joint values of keyframes a and b, read by leeway itself."""
+    r = subprocess.run([LEEWAY, "bounds", str(cell), "--from", a, "--to", b, "--safety", "none", "--json"],
+                       capture_output=True, text=True)
+    if r.returncode != 0:
+        sys.exit(f"scale_bench: leeway bounds {cell} --from {a} --to {b}: {r.stderr.strip()}")
+    d = json.loads(r.stdout)
+    return d["joints"], d["waypoints"][0]["q"], d["waypoints"][-1]["q"]
+
+
+def path_file(folder, cell, joints, a, b, n):
+    """A leeway-path-1 file: n waypoints evenly spaced on the joint-linear path from a to b."""
+    waypoints = [{"q": [x + (y - x) * k / (n - 1) for x, y in zip(a, b)]} for k in range(n)]
+    doc = {"format": "leeway-path-1", "cell": str(cell), "joints": joints, "units": {"q": "rad or m"},
+           "waypoints": waypoints}
+    p = folder / f"path_{n}.json"
+    p.write_text(json.dumps(doc))
+    return p
+
+
+def crowded_cell(folder, base, count, seed):
+    """The base cell with `count` extra 4 x 4 x 20 cm obstacle boxes over 8 x 8 m (seeded)."""
+    text = base.read_text()
+    rng = random.Random(seed)
+    boxes = "".join(
+        f'<geom name="crowd{k}" type="box" pos="{rng.uniform(-4, 4):.3f} {rng.uniform(-4, 4):.3f} 0.1" '
+        f'size="0.02 0.02 0.1"/>\n' for k in range(count))
+    at = text.rindex("</worldbody>")
+    # Beside a copy of mjcf/, so that the cell's includes (../robots/...) resolve as in the repository.
+    shutil.copytree(base.parent.parent, folder / "mjcf")
+    p = folder / "mjcf" / "workcells" / f"crowded_{count}.xml"
+    p.write_text(text[:at] + boxes + text[at:])
+    return p
+
+
+def main():
+    global LEEWAY
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--build", default="build")
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--waypoints", type=int, default=1000)
+    ap.add_argument("--obstacles", type=int, default=20000)
+    args = ap.parse_args()
+    LEEWAY = str((ROOT / args.build / "leeway").resolve())
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = pathlib.Path(tmp)
+        for name, a, b in [("dallara", "home", "patch"), ("shelf_bay", "pick", "place")]:
+            cell = ROOT / "mjcf" / "workcells" / f"{name}.xml"
+            joints, qa, qb = ends(cell, a, b)
+            p = path_file(folder, cell, joints, qa, qb, args.waypoints)
+            out = folder / "bounds.json"
+            runs = [timed([LEEWAY, "bounds", str(cell), "--path", str(p), "--out", str(out)])
+                    for _ in range(args.repeats)]
+            d = json.loads(out.read_text())
+            s = d["safety"]
+            note = (f"{len(d['waypoints'])} waypoints, {'certified' if s['certified'] else 'NOT certified'}, "
+                    f"{s['leaves']} leaves")
+            rows.append((f"bounds {name} {a}-{b} --path ({args.waypoints} waypoints)", runs, 30.0, note))
+        cell = crowded_cell(folder, ROOT / "mjcf" / "workcells" / "shelf_bay.xml", args.obstacles, 1)
+        # Exit 1: check's findings (the random boxes overlap each other and the robot's reach).
+        runs = [timed([LEEWAY, "check", str(cell), "--json"], ok=(0, 1)) for _ in range(args.repeats)]
+        report = json.loads(runs[-1][2])
+        rows.append((f"check shelf_bay + {args.obstacles} obstacles", runs, 5.0,
+                     f"{len(report.get('overlaps', []))} obstacle overlaps reported"))
+    print(f"Machine: {machine()}; {args.repeats} runs per case, median wall time [s].\n")
+    print("| case | wall median [s] | CPU median [s] | target [s] | met | reported |")
+    print("|---|---:|---:|---:|---|---|")
+    for name, runs, target, note in rows:
+        wall = statistics.median(r[0] for r in runs)
+        cpu = statistics.median(r[1] for r in runs)
+        print(f"| {name} | {wall:.2f} | {cpu:.2f} | {target:g} | {'yes' if wall <= target else 'NO'} | {note} |")
+
+
+if __name__ == "__main__":
+    main()

@@ -11,7 +11,8 @@
 // refuse the robot with an InputError of its own (a joint range beyond kMaxLength, a limit MuJoCo's
 // compiler reads differently), but "MJCF does not compile" means the importer wrote MJCF MuJoCo
 // rejects, a finding. Anything else is a finding: another exception, a crash, a sanitizer report,
-// a leak, a timeout.
+// a leak, a timeout. One leak is urdfdom's, not leeway's, and suppressed for this target only:
+// fuzz/urdf.lsan.supp says which.
 //
 // The input is TMP/leeway-fuzz-XXXXXX/robot.urdf; the folder also holds meshes/cube.stl and the
 // package pkgs/leeway_test_irb6700/meshes/link_{3,5}.stl (unit cubes, ASCII STL), with pkgs as the

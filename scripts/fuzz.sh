@@ -51,7 +51,7 @@ for name in $targets; do
   [ -f "$repo/fuzz/$name.dict" ] && dict+=("-dict=$repo/fuzz/$name.dict")
   # A library's leak leeway cannot prevent, documented in fuzz/NAME.lsan.supp.
   lsan="${LSAN_OPTIONS:-}"
-  [ -f "$repo/fuzz/$name.lsan.supp" ] && lsan="suppressions=$repo/fuzz/$name.lsan.supp${lsan:+:$lsan}"
+  [ -f "$repo/fuzz/$name.lsan.supp" ] && lsan="suppressions=$repo/fuzz/$name.lsan.supp:print_suppressions=0${lsan:+:$lsan}"
   echo "fuzz.sh: $name for $seconds s (log: $out/$name.log)"
   status=0
   # From the scratch folder, so that nothing the target or MuJoCo writes lands in the repository.

@@ -30,6 +30,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "fuzz_input.hpp"
 #include "leeway/cell_defaults.hpp"

@@ -126,6 +126,16 @@ void Scene::recognise(const SceneOptions& options) {
       throw InputError(file + ": joint " + label + " range '" + format_number(rj.lower) + " " +
                        format_number(rj.upper) + "'" + unit + " goes beyond +-" + format_number(kMaxLength) +
                        unit + " (after MuJoCo's unit conversion); no robot joint moves that far");
+    // MuJoCo compiles a NaN or inf joint axis or anchor (it normalises the axis without checking):
+    // the links' poses are then NaN at every value but the reference, and the midphase's cell
+    // index of a NaN coordinate is undefined behaviour (issue 14's fuzzing; fuzz/regressions/cell/).
+    auto require_finite = [&](const char* what, const mjtNum* v) {
+      if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
+        throw InputError(file + ": joint " + label + " " + what + " '" + format_number(v[0]) + " " +
+                         format_number(v[1]) + " " + format_number(v[2]) + "' is not finite");
+    };
+    require_finite("axis", m.jnt_axis + 3 * j);
+    require_finite("pos", m.jnt_pos + 3 * j);
     if (m.nuser_jnt > 0) {
       rj.max_speed = m.jnt_user[j * m.nuser_jnt];
       if (!std::isfinite(rj.max_speed) || rj.max_speed < 0)
@@ -228,6 +238,10 @@ void Scene::recognise(const SceneOptions& options) {
     refuse("quat", m.geom_quat + 4 * g, 4, 2.0, "");
     refuse("world position", d->geom_xpos + 3 * g, 3, kMaxLength, " m");
     refuse("world orientation", d->geom_xmat + 9 * g, 9, 2.0, "");
+    // The contact margin and gap widen every collision query: a NaN made the midphase's cell index
+    // undefined behaviour, an inf one made every geom touch (issue 14's fuzzing; fuzz/regressions/cell/).
+    refuse("margin", m.geom_margin + g, 1, kMaxLength, " m");
+    refuse("gap", m.geom_gap + g, 1, kMaxLength, " m");
   }
   std::vector<int> statics;
   for (int g = 0; g < m.ngeom; ++g)

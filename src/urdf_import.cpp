@@ -207,6 +207,18 @@ class Importer {
     urdf_dir_ = fs::path(file_).parent_path().string();
     if (urdf_dir_.empty()) urdf_dir_ = ".";
   }
+  // urdfdom's links own their child links and joints (shared_ptr): the joint loops that
+  // check_tree and find_tool refuse are cycles of owners that would outlive the model and leak
+  // (found by fuzz/fuzz_urdf.cpp). Nothing of the model is used after the import: break them.
+  ~Importer() {
+    if (!model_) return;
+    for (auto& [name, link] : model_->links_) {
+      link->child_links.clear();
+      link->child_joints.clear();
+    }
+  }
+  Importer(const Importer&) = delete;
+  Importer& operator=(const Importer&) = delete;
 
   UrdfImport run() {
     std::ifstream in(file_);

@@ -11,6 +11,18 @@
 #include <fstream>
 #include <random>
 
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define LEEWAY_TEST_LSAN 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__) && !defined(LEEWAY_TEST_LSAN)
+#define LEEWAY_TEST_LSAN 1
+#endif
+#ifdef LEEWAY_TEST_LSAN
+#include <sanitizer/lsan_interface.h>
+#endif
+
 #include "leeway/box.hpp"
 #include "leeway/kinematics.hpp"
 #include "leeway/scene.hpp"
@@ -544,6 +556,45 @@ TEST(UrdfImportCliTest, FourJointArmPlansAndBounds) {
       test::run_cli("cf " + quoted(cell) + " " + quoted(bounds) + " --samples 2000 --threads 1 --json");
   ASSERT_EQ(cf.exit_code, 0) << cf.out;
   EXPECT_EQ(nlohmann::json::parse(cf.out).at("cf").get<double>(), 1.0);
+}
+
+// A joint loop is refused, and the refused model does not leak: urdfdom's links own their children
+// (shared_ptr), so the loop was a cycle of owners that outlived the import (found by
+// fuzz/fuzz_urdf.cpp; fuzz/regressions/urdf/joint_loop_leak.urdf). Needs LeakSanitizer
+// (LEEWAY_SANITIZE=address).
+TEST(UrdfImportLeakTest, RefusedJointLoopsLeaveNoLeak) {
+#ifndef LEEWAY_TEST_LSAN
+  GTEST_SKIP() << "needs LeakSanitizer: build with LEEWAY_SANITIZE=address";
+#else
+  test::TempDir dir;
+  const std::string loop = dir.write(
+      "loop.urdf",
+      edited(
+          kTwoJoints, "</robot>",
+          R"(<joint name="back" type="fixed"><parent link="link_2"/><child link="link_1"/></joint></robot>)"));
+  const std::string cycle = dir.write(
+      "cycle.urdf",
+      edited(
+          kTwoJoints, "</robot>",
+          R"(<link name="ring_a"/><link name="ring_b"/><joint name="r1" type="fixed"><parent link="ring_a"/>)"
+          R"(<child link="ring_b"/></joint><joint name="r2" type="fixed"><parent link="ring_b"/>)"
+          R"(<child link="ring_a"/></joint></robot>)"));
+  UrdfImportOptions ring;
+  ring.tool_link = "ring_b";
+  try {
+    import_urdf(loop);
+    ADD_FAILURE() << "a joint loop was imported";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("loop.urdf: link 'link_1' is the child of joints 'back', 'j1'"));
+  }
+  try {
+    import_urdf(cycle, ring);
+    ADD_FAILURE() << "a joint loop was imported";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("cycle.urdf: link 'ring_b' lies on a joint loop above the tool link"));
+  }
+  EXPECT_EQ(__lsan_do_recoverable_leak_check(), 0) << "the refused URDF models leaked (report above)";
+#endif
 }
 
 }  // namespace

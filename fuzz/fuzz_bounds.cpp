@@ -1,0 +1,57 @@
+// libFuzzer target: a bounds file through read_bounds for the bundled cell mjcf/workcells/dallara.xml
+// (six hinge joints j1..j6), loaded once (docs/testing.md, "Fuzzing").
+//
+// Contract: read_bounds (bounds_file.hpp) returns one WaypointBounds per waypoint, each within the
+// joint limits with lower <= q <= upper, or throws leeway::InputError naming the file and the
+// mismatch: unreadable file or malformed JSON (as read_params), not a bounds file, another
+// "format", other joints, wrong sizes or types (nlohmann's type errors are turned into InputError
+// "unexpected content"), bounds outside the limits, a nominal outside its bounds, an unknown
+// collapsed joint. Anything else is a finding: another exception, a crash, a sanitizer report, a
+// leak, a timeout, or a result that breaks the guarantees above.
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+
+#include "fuzz_input.hpp"
+#include "leeway/bounds_file.hpp"
+#include "leeway/mujoco_util.hpp"
+#include "leeway/scene.hpp"
+
+namespace {
+
+std::unique_ptr<leeway::Scene> g_scene;
+
+}  // namespace
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  leeway::install_mujoco_error_handlers();
+  g_scene = std::make_unique<leeway::Scene>(
+      leeway::Scene::load(leeway::fuzz::kSourceDir + "/mjcf/workcells/dallara.xml"));
+  return 0;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  static const leeway::fuzz::InputFile input("bounds.json");
+  const std::string& path = input.write(data, size);
+  const leeway::Scene& scene = *g_scene;
+  try {
+    const auto bounds = leeway::read_bounds(path, scene);
+    for (const auto& w : bounds) {
+      bool ok = w.q.size() == scene.dof() && w.lower.size() == scene.dof() && w.upper.size() == scene.dof() &&
+                static_cast<int>(w.collapsed.size()) == scene.dof();
+      for (int k = 0; ok && k < scene.dof(); ++k) {
+        const auto& j = scene.joints()[static_cast<size_t>(k)];
+        ok = j.lower <= w.lower[k] && w.lower[k] <= w.q[k] && w.q[k] <= w.upper[k] && w.upper[k] <= j.upper;
+      }
+      if (!ok) {
+        std::fprintf(stderr, "leeway fuzz: read_bounds returned bounds outside its guarantees\n");
+        std::abort();
+      }
+    }
+  } catch (const leeway::InputError& e) {
+    leeway::fuzz::require_names_file(e, path);
+  }
+  return 0;
+}

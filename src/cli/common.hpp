@@ -53,7 +53,8 @@ inline std::optional<int> parse_cli(CLI::App& app, int argc, char** argv, const 
     if (dynamic_cast<const CLI::RequiredError*>(&e)) {
       const std::vector<std::string> extra = app.remaining(true);
       if (!extra.empty()) {
-        message = "The following argument" + std::string(extra.size() > 1 ? "s were" : " was") + " not expected:";
+        message =
+            "The following argument" + std::string(extra.size() > 1 ? "s were" : " was") + " not expected:";
         for (const auto& arg : extra) message += " " + arg;
       }
     }

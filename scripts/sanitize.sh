@@ -58,7 +58,7 @@ run_thread() {
 
 run_fuzz() {
   local dir="${1:-build-asan}"
-  if [ ! -x "$dir/leeway-fuzz-cell" ]; then run_address "$dir"; fi
+  if [ ! -x "$dir/fuzz/leeway-fuzz-cell" ]; then run_address "$dir"; fi
   bash scripts/fuzz.sh "${LEEWAY_FUZZ_SECONDS:-60}" "$dir"
 }
 

@@ -12,30 +12,19 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <memory>
 
 #include "fuzz_input.hpp"
 #include "leeway/bounds_file.hpp"
-#include "leeway/mujoco_util.hpp"
-#include "leeway/scene.hpp"
-
-namespace {
-
-std::unique_ptr<leeway::Scene> g_scene;
-
-}  // namespace
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
-  leeway::install_mujoco_error_handlers();
-  g_scene = std::make_unique<leeway::Scene>(
-      leeway::Scene::load(leeway::fuzz::kSourceDir + "/mjcf/workcells/dallara.xml"));
+  leeway::fuzz::dallara_scene();
   return 0;
 }
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const leeway::fuzz::InputFile input("bounds.json");
   const std::string& path = input.write(data, size);
-  const leeway::Scene& scene = *g_scene;
+  const leeway::Scene& scene = leeway::fuzz::dallara_scene();
   try {
     const auto bounds = leeway::read_bounds(path, scene);
     for (const auto& w : bounds) {

@@ -15,6 +15,8 @@
 #include <string>
 
 #include "leeway/error.hpp"
+#include "leeway/mujoco_util.hpp"
+#include "leeway/scene.hpp"
 
 namespace leeway::fuzz {
 
@@ -74,6 +76,16 @@ inline void require_names_file(const InputError& e, const std::string& path) {
                  message.c_str());
     std::abort();
   }
+}
+
+//! The bundled Dallara cell (six hinge joints j1..j6), loaded once per process: the scene the
+//! bounds and path readers check their files against. Called from LLVMFuzzerInitialize.
+inline const Scene& dallara_scene() {
+  static const Scene scene = [] {
+    install_mujoco_error_handlers();
+    return Scene::load(kSourceDir + "/mjcf/workcells/dallara.xml");
+  }();
+  return scene;
 }
 
 }  // namespace leeway::fuzz

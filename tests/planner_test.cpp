@@ -277,14 +277,18 @@ TEST_F(PlannerTest, StartOrGoalInCollisionOrOutsideTheLimitsIsBadInput) {
   EXPECT_NE(message(free, hit).find(scene.source()), std::string::npos);
 }
 
-TEST_F(PlannerTest, NoPathWithinTheTimeLimitIsAnOutcome) {
-  // The wall stands across the arm's only way from 0 to 2.5 rad: no path exists.
+// A one-link arm whose only way from 0 to 2.5 rad a wall blocks: no path exists.
+struct WalledIn {
   test::TempDir dir;
-  const Scene scene = Scene::load(
+  Scene scene = Scene::load(
       dir.write("cell.xml", one_link_cell(R"(<geom name="wall" type="box" size="1 0.05 1" pos="0 1 1"/>)")));
-  Eigen::VectorXd a(1), b(1);
-  a << 0.0;
-  b << 2.5;
+  Eigen::VectorXd a = Eigen::VectorXd::Constant(1, 0.0), b = Eigen::VectorXd::Constant(1, 2.5);
+};
+
+TEST_F(PlannerTest, NoPathWithinTheTimeLimitIsAnOutcome) {
+  const WalledIn w;
+  const Scene& scene = w.scene;
+  const Eigen::VectorXd &a = w.a, &b = w.b;
   PlanOptions o;
   o.time_limit = 0.2;
   const auto t0 = std::chrono::steady_clock::now();
@@ -304,16 +308,11 @@ TEST_F(PlannerTest, NoPathWithinTheTimeLimitIsAnOutcome) {
 TEST_F(PlannerTest, TheTreesStopAtTheirStateLimitWhateverTheTimeLimit) {
   // The same impossible problem with an hour to spend: the state limit (the memory guard) ends it
   // after exactly max_states motion checks, each at least one collision check.
-  test::TempDir dir;
-  const Scene scene = Scene::load(
-      dir.write("cell.xml", one_link_cell(R"(<geom name="wall" type="box" size="1 0.05 1" pos="0 1 1"/>)")));
-  Eigen::VectorXd a(1), b(1);
-  a << 0.0;
-  b << 2.5;
+  const WalledIn w;
   PlanOptions o;
   o.time_limit = 3600;
   o.max_states = 200;
-  const PlanResult r = plan_path(scene, a, b, o, "start 'a'", "goal 'b'");
+  const PlanResult r = plan_path(w.scene, w.a, w.b, o, "start 'a'", "goal 'b'");
   EXPECT_FALSE(r.success);
   EXPECT_NE(r.message.find("no collision-free path from start 'a' to goal 'b' found in 200 motions"),
             std::string::npos)

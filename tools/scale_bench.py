@@ -3,13 +3,14 @@
 
   1. `leeway bounds CELL --path P` on a joint-linear path file of N waypoints (default 1,000) at
      default settings (leeway preset, certified safety stage, all hardware threads); target <= 30 s.
+     The path runs between two keyframes of a bundled cell (--path-case CELL:FROM:TO).
   2. `leeway check` on a cell with 20,000 extra obstacles (4 x 4 x 20 cm boxes at seeded random
      places over 8 x 8 m, overlaps included); target <= 5 s.
 
 Every input is generated into a temporary folder (nothing is written to the repository); each case
 runs --repeats times and the table gives the median wall time [s], the CPU time [s] and what the
 run reported. Usage: python3 tools/scale_bench.py [--build build] [--repeats 3] [--waypoints 1000]
-[--obstacles 20000]
+[--obstacles 20000] [--only bounds|check] [--path-case CELL:FROM:TO ...]
 """
 import argparse
 import json
@@ -86,12 +87,16 @@ def main():
     ap.add_argument("--waypoints", type=int, default=1000)
     ap.add_argument("--obstacles", type=int, default=20000)
     ap.add_argument("--only", choices=["bounds", "check"], help="run one of the two cases")
+    ap.add_argument("--path-case", action="append", metavar="CELL:FROM:TO",
+                    help="bundled cell and keyframes of a bounded path (repeatable; default "
+                         "dallara:home:patch and baltico:home:patch)")
     args = ap.parse_args()
     LEEWAY = str((ROOT / args.build / "leeway").resolve())
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         folder = pathlib.Path(tmp)
-        paths = [] if args.only == "check" else [("dallara", "home", "patch"), ("shelf_bay", "pick", "place")]
+        cases = args.path_case or ["dallara:home:patch", "baltico:home:patch"]
+        paths = [] if args.only == "check" else [tuple(c.split(":")) for c in cases]
         for name, a, b in paths:
             cell = ROOT / "mjcf" / "workcells" / f"{name}.xml"
             joints, qa, qb = ends(cell, a, b)

@@ -130,6 +130,10 @@ def main():
     perf = ROOT / "docs" / "data" / "perf" / "section.md"
     if perf.exists():
         o.append(perf.read_text())
+    # Inputs far larger than the thesis's: tools/scale_bench.py --out writes this section.
+    scale = ROOT / "docs" / "data" / "perf" / "scale.md"
+    if scale.exists():
+        o.append(scale.read_text())
     for cell, src, dst, table in PATHS:
         o.append(f"## {cell.capitalize() if cell != 'dlr' else 'DLR'} {src}-{dst} (thesis table {table})\n")
         plot = f"images/sweep-{cell}-{src}-{dst}.svg"

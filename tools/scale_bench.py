@@ -87,6 +87,8 @@ def main():
     ap.add_argument("--waypoints", type=int, default=1000)
     ap.add_argument("--obstacles", type=int, default=20000)
     ap.add_argument("--only", choices=["bounds", "check"], help="run one of the two cases")
+    ap.add_argument("--out", help="also write the table as a docs section here (docs/data/perf/scale.md, "
+                                  "which tools/make_results.py includes in docs/results.md)")
     ap.add_argument("--path-case", action="append", metavar="CELL:FROM:TO",
                     help="bundled cell and keyframes of a bounded path (repeatable; default "
                          "dallara:home:patch and baltico:home:patch)")
@@ -116,14 +118,22 @@ def main():
             report = json.loads(runs[-1][2])
             rows.append((f"check shelf_bay + {args.obstacles} obstacles", runs, 5.0,
                          f"{len(report.get('overlaps', []))} obstacle overlaps reported"))
-    print(f"Machine: {machine()}; {args.repeats} runs per case, median wall time [s].\n")
-    print("| case | wall median [s] | CPU median [s] | target [s] | met | reported |")
-    print("|---|---:|---:|---:|---|---|")
+    lines = [f"Machine: {machine()}; load average {os.getloadavg()[0]:.2f} at the end; {args.repeats} runs "
+             f"per case, median wall time [s].", "",
+             "| case | wall median [s] | CPU median [s] | target [s] | met | reported |",
+             "|---|---:|---:|---:|---|---|"]
     for name, runs, target, note in rows:
         wall = statistics.median(r[0] for r in runs)
         cpu = statistics.median(r[1] for r in runs)
-        print(f"| {name} | {wall:.2f} | {cpu:.2f} | {target:g} | {'yes' if wall <= target else 'NO'} | {note} |")
-
+        lines.append(f"| {name} | {wall:.2f} | {cpu:.2f} | {target:g} | {'yes' if wall <= target else 'NO'} | {note} |")
+    print("\n".join(lines))
+    if args.out:
+        section = ["## Scale (issue 14)", "",
+                   "`python3 tools/scale_bench.py --out docs/data/perf/scale.md`: a joint-linear path file of "
+                   f"{args.waypoints} waypoints bounded at default settings (leeway preset, certified safety "
+                   "stage, all hardware threads), and `leeway check` on shelf_bay with "
+                   f"{args.obstacles} extra 4 x 4 x 20 cm obstacles (seeded random places over 8 x 8 m).", ""]
+        pathlib.Path(args.out).write_text("\n".join(section + lines) + "\n\n")
 
 if __name__ == "__main__":
     main()

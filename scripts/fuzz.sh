@@ -9,7 +9,7 @@
 # fuzz/regressions/NAME read as seeds too and fuzz/NAME.dict as its dictionary, one target after
 # the other. Output goes to FUZZ_OUT (default BUILD_DIR/fuzz-out, emptied first): NAME.log,
 # corpus/NAME (the grown corpus) and artifacts/NAME/ (reproducers). Environment: FUZZ_TARGETS
-# (default "cell params bounds path urdf") picks targets.
+# (default "cell params bounds path urdf") picks targets, FUZZ_SEED (default 1) libFuzzer's seed.
 #
 # Exit status: 0 when no target found anything; 1 when one found a crash, sanitizer report, leak,
 # timeout (> 10 s per input) or out-of-memory (> 2048 MB): the reproducer's path and the command
@@ -22,6 +22,8 @@ build="${2:-$repo/build-fuzz}"
 build="$(cd "$build" && pwd)"
 out="${FUZZ_OUT:-$build/fuzz-out}"
 targets="${FUZZ_TARGETS:-cell params bounds path urdf}"
+# libFuzzer's random seed: fixed, so that a CI run can be repeated (FUZZ_SEED=0: a random one).
+seed="${FUZZ_SEED:-1}"
 
 if ! [[ "$seconds" =~ ^[0-9]+$ ]] || [ "$seconds" -lt 1 ]; then
   echo "fuzz.sh: SECONDS_PER_TARGET '$seconds' must be a whole number >= 1" >&2
@@ -51,11 +53,12 @@ for name in $targets; do
   [ -f "$repo/fuzz/$name.dict" ] && dict+=("-dict=$repo/fuzz/$name.dict")
   # A library's leak leeway cannot prevent, documented in fuzz/NAME.lsan.supp.
   lsan="${LSAN_OPTIONS:-}"
-  [ -f "$repo/fuzz/$name.lsan.supp" ] && lsan="suppressions=$repo/fuzz/$name.lsan.supp:print_suppressions=0${lsan:+:$lsan}"
+  # Last, so that it wins over a suppressions file the environment names (LeakSanitizer reads one).
+  [ -f "$repo/fuzz/$name.lsan.supp" ] && lsan="${lsan:+$lsan:}suppressions=$repo/fuzz/$name.lsan.supp:print_suppressions=0"
   echo "fuzz.sh: $name for $seconds s (log: $out/$name.log)"
   status=0
   # From the scratch folder, so that nothing the target or MuJoCo writes lands in the repository.
-  (cd "$out" && LSAN_OPTIONS="$lsan" "$bin" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+  (cd "$out" && LSAN_OPTIONS="$lsan" "$bin" -max_total_time="$seconds" -seed="$seed" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
     "${dict[@]}" -artifact_prefix="$artifacts/" "$corpus" "${seeds[@]}") >"$out/$name.log" 2>&1 || status=$?
   execs="$(sed -n 's/^stat::number_of_executed_units: *//p' "$out/$name.log" | tail -1)"
   rate="$(sed -n 's/^stat::average_exec_per_sec: *//p' "$out/$name.log" | tail -1)"

@@ -153,6 +153,11 @@ TEST(OutputFiles, SigtermRemovesTheTemporaryFile) {
 // Under an address-space limit that leaves no room for more thread stacks, parallel_for runs every
 // item on the threads it could create instead of terminating the process.
 TEST(Threads, CreationFailureFallsBackToFewerThreads) {
+#ifdef LEEWAY_TEST_ASAN
+  // Under ASan an address-space limit fails ASan's own fake-stack mappings for a new thread, which
+  // abort the process before std::thread can report anything.
+  GTEST_SKIP() << "an address-space limit cannot be tested under AddressSanitizer";
+#endif
   const pid_t child = ::fork();
   ASSERT_GE(child, 0);
   if (child == 0) {

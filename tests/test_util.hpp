@@ -17,6 +17,15 @@
 
 #include "leeway/mujoco_util.hpp"
 
+// LEEWAY_TEST_ASAN: this build runs under AddressSanitizer (LEEWAY_SANITIZE=address, gcc or clang).
+#if defined(__SANITIZE_ADDRESS__)
+#define LEEWAY_TEST_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define LEEWAY_TEST_ASAN 1
+#endif
+#endif
+
 namespace leeway::test {
 
 //! A temporary directory removed when the object dies.

@@ -11,23 +11,15 @@
 #include <fstream>
 #include <random>
 
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define LEEWAY_TEST_LSAN 1
-#endif
-#endif
-#if defined(__SANITIZE_ADDRESS__) && !defined(LEEWAY_TEST_LSAN)
-#define LEEWAY_TEST_LSAN 1
-#endif
-#ifdef LEEWAY_TEST_LSAN
-#include <sanitizer/lsan_interface.h>
-#endif
-
 #include "leeway/box.hpp"
 #include "leeway/kinematics.hpp"
 #include "leeway/scene.hpp"
 #include "stl_util.hpp"
 #include "test_util.hpp"
+
+#ifdef LEEWAY_TEST_ASAN
+#include <sanitizer/lsan_interface.h>
+#endif
 
 namespace leeway {
 namespace {
@@ -563,7 +555,7 @@ TEST(UrdfImportCliTest, FourJointArmPlansAndBounds) {
 // fuzz/fuzz_urdf.cpp; fuzz/regressions/urdf/joint_loop_leak.urdf). Needs LeakSanitizer
 // (LEEWAY_SANITIZE=address).
 TEST(UrdfImportLeakTest, RefusedJointLoopsLeaveNoLeak) {
-#ifndef LEEWAY_TEST_LSAN
+#ifndef LEEWAY_TEST_ASAN
   GTEST_SKIP() << "needs LeakSanitizer: build with LEEWAY_SANITIZE=address";
 #else
   test::TempDir dir;

@@ -25,9 +25,6 @@ constexpr int kRegrowSteps = 4;
 // A slab (what one regrow step adds) gets this fraction of the leaf budget: a slab that needs more
 // is not worth its cost.
 constexpr long kSlabBudgetDivisor = 4;
-// The regrow of one segment stops once it has spent this many times the leaf budget (shrunk
-// extents it did not reach keep their shrunk values).
-constexpr long kRegrowBudgetFactor = 4;
 // Random configurations a probe checks besides the corners.
 constexpr int kProbeSamples = 200;
 
@@ -146,12 +143,9 @@ SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& g
   if (s.passed && s.shrink_steps > 0) {
     std::vector<size_t> ends = {a};
     if (b != a) ends.push_back(b);
-    const long regrow_start = stats.leaves;
     for (int i = 0; i < n; ++i)
       for (size_t k : ends)
         for (int side = 0; side < 2; ++side) {
-          // A bound on the regrow's cost: in a tight spot every slab fails at its full budget.
-          if (stats.leaves - regrow_start >= kRegrowBudgetFactor * certifier.options().max_leaves) break;
           double& extent = side ? e.above[k][i] : e.below[k][i];
           const double shrunk_to = extent, guide_extent = side ? guide.above[k][i] : guide.below[k][i];
           if (!(guide_extent > shrunk_to)) continue;

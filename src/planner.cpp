@@ -240,14 +240,11 @@ class MotionValidator : public ob::MotionValidator {
     return false;
   }
 
- private:
-  std::shared_ptr<Checker> checker_;
-
- public:
   //! Motions checked so far: an upper bound of the states RRT-Connect added to its trees.
   long motions() const { return motions_.load(); }
 
  private:
+  std::shared_ptr<Checker> checker_;
   mutable std::atomic<long> motions_{0};
 };
 
@@ -308,9 +305,9 @@ void validate(const PlanOptions& o) {
   finite_positive(o.time_limit, "time_limit", 1e-3, 86400, "s");
   finite_positive(o.resolution, "resolution", 1e-5, 1.0, "rad");
   finite_positive(o.slide_resolution, "slide_resolution", 1e-5, 1.0, "m");
-  if (o.max_states < 16 || o.max_states > 16L * 1024 * 1024)
+  if (o.max_states < 16 || o.max_states > kMaxPlanStates)
     throw InputError("plan option 'max_states' = " + std::to_string(o.max_states) + " must be from 16 to " +
-                     std::to_string(16L * 1024 * 1024) + " (the memory limit of RRT-Connect's trees)");
+                     std::to_string(kMaxPlanStates) + " (the memory limit of RRT-Connect's trees)");
   if (!(std::isfinite(o.range) && o.range >= 0))
     throw InputError("plan option 'range' = " + format_number(o.range) +
                      " rad must be a finite number >= 0 (0: OMPL's default)");

@@ -18,6 +18,9 @@
 namespace leeway {
 
 //! Parameters of plan_path(). Every value is SI (seconds, radians, metres).
+//! Largest PlanOptions::max_states: about 3.2 GiB of RRT-Connect trees at ~200 bytes per state.
+inline constexpr long kMaxPlanStates = 16L * 1024 * 1024;
+
 struct PlanOptions {
   double time_limit = 5.0;  //!< [s] RRT-Connect's budget; the simplifier and checks come on top
   //! Seed of every random choice (RRT-Connect's samples, the simplifier's shortcuts): the same seed
@@ -44,7 +47,7 @@ struct PlanOptions {
   //! checks, each of which may add one state to its trees. At about 200 bytes per state (OMPL's
   //! motion, state and nearest-neighbour entry, our estimate) the default keeps the trees below
   //! about 3.2 GiB however long the time limit is.
-  long max_states = 16L * 1024 * 1024;
+  long max_states = kMaxPlanStates;
 };
 
 //! Outcome of plan_path(). Not finding a path is an outcome, not an error.

@@ -15,21 +15,15 @@ import heapq
 import json
 import os
 import pathlib
-import resource
 import shutil
 import statistics
 import subprocess
 import tempfile
 import time
 
-from machine_info import machine
+from machine_info import cpu_of_children, machine
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-
-
-def cpu_of_children():
-    r = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return r.ru_utime + r.ru_stime
 
 
 def run(cmd):

@@ -35,15 +35,65 @@ Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
 
 }  // namespace
 
+void update_robot_kinematics(const Scene& scene, mjData& d) {
+  // MuJoCo 2.2's mj_kinematics (engine_core_smooth.c) restricted to the moving bodies, whose
+  // parents come first (MuJoCo's body order). Omitted because they cannot apply here: free joints,
+  // ball joints and qpos quaternions (Scene accepts hinge and slide joints only), mocap bodies
+  // (children of the world without joints, so never moving).
+  const mjModel& m = scene.model();
+  mjtNum pos[3], quat[4], qloc[4], qtmp[4], vec[3], vec1[3], xanchor[3], xaxis[3];
+  for (int i : scene.moving_bodies()) {
+    const int pid = m.body_parentid[i];
+    mju_rotVecMat(vec, m.body_pos + 3 * i, d.xmat + 9 * pid);
+    mju_add3(pos, d.xpos + 3 * pid, vec);
+    mju_mulQuat(quat, d.xquat + 4 * pid, m.body_quat + 4 * i);
+    for (int j = 0; j < m.body_jntnum[i]; ++j) {
+      const int jid = m.body_jntadr[i] + j;
+      const int qadr = m.jnt_qposadr[jid];
+      mju_rotVecQuat(xaxis, m.jnt_axis + 3 * jid, quat);
+      mju_rotVecQuat(xanchor, m.jnt_pos + 3 * jid, quat);
+      mju_addTo3(xanchor, pos);
+      if (m.jnt_type[jid] == mjJNT_SLIDE) {
+        mju_addToScl3(pos, xaxis, d.qpos[qadr] - m.qpos0[qadr]);
+      } else {  // hinge
+        mju_axisAngle2Quat(qloc, m.jnt_axis + 3 * jid, d.qpos[qadr] - m.qpos0[qadr]);
+        mju_mulQuat(qtmp, quat, qloc);
+        mju_copy4(quat, qtmp);
+        // Off-centre rotation: the anchor stays where it was.
+        mju_sub3(vec, xanchor, pos);
+        mju_rotVecQuat(vec1, m.jnt_pos + 3 * jid, quat);
+        for (int k = 0; k < 3; ++k) pos[k] += (vec[k] - vec1[k]);
+      }
+      mju_copy3(d.xanchor + 3 * jid, xanchor);
+      mju_copy3(d.xaxis + 3 * jid, xaxis);
+    }
+    mju_normalize4(quat);
+    mju_copy4(d.xquat + 4 * i, quat);
+    mju_copy3(d.xpos + 3 * i, pos);
+    mju_quat2Mat(d.xmat + 9 * i, quat);
+  }
+  for (int i : scene.moving_bodies())
+    mj_local2Global(&d, d.xipos + 3 * i, d.ximat + 9 * i, m.body_ipos + 3 * i, m.body_iquat + 4 * i, i,
+                    m.body_sameframe[i]);
+  for (int g : scene.moving_geoms())
+    mj_local2Global(&d, d.geom_xpos + 3 * g, d.geom_xmat + 9 * g, m.geom_pos + 3 * g, m.geom_quat + 4 * g,
+                    m.geom_bodyid[g], m.geom_sameframe[g]);
+  for (int s : scene.moving_sites())
+    mj_local2Global(&d, d.site_xpos + 3 * s, d.site_xmat + 9 * s, m.site_pos + 3 * s, m.site_quat + 4 * s,
+                    m.site_bodyid[s], m.site_sameframe[s]);
+}
+
 RobotState::RobotState(const Scene& scene) : scene_(&scene), data_(make_data(scene.model())) {
   // Idempotent; documented at install_mujoco_error_handlers(): MuJoCo must throw, not exit().
   install_mujoco_error_handlers();
+  // Once over everything (the obstacles' poses); set() then updates the moving part only.
+  mj_kinematics(&scene.model(), data_.get());
 }
 
 void RobotState::set(const Eigen::VectorXd& q) {
   scene_->validate_configuration(q, "configuration");
   scene_->set_qpos(*data_, q);
-  mj_kinematics(&scene_->model(), data_.get());
+  update_robot_kinematics(*scene_, *data_);
 }
 
 Pose RobotState::site_pose(int site) const {

@@ -146,6 +146,17 @@ void Scene::recognise(const SceneOptions& options) {
   }
   LEEWAY_DEMAND(m.nq == m.njnt);
 
+  // What moves with the joints. MuJoCo numbers bodies parents first, so one pass suffices.
+  std::vector<bool> moving(static_cast<size_t>(m.nbody), false);
+  for (int b = 1; b < m.nbody; ++b) {
+    moving[static_cast<size_t>(b)] = m.body_jntnum[b] > 0 || moving[static_cast<size_t>(m.body_parentid[b])];
+    if (moving[static_cast<size_t>(b)]) moving_bodies_.push_back(b);
+  }
+  for (int g = 0; g < m.ngeom; ++g)
+    if (moving[static_cast<size_t>(m.geom_bodyid[g])]) moving_geoms_.push_back(g);
+  for (int s = 0; s < m.nsite; ++s)
+    if (moving[static_cast<size_t>(m.site_bodyid[s])]) moving_sites_.push_back(s);
+
   // Geoms: links, robot base, obstacles; bitmasks normalised for robot-versus-obstacle contacts.
   roles_.assign(static_cast<size_t>(m.ngeom), GeomRole::kIgnored);
   for (int g = 0; g < m.ngeom; ++g) {

@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <random>
 
 #include "leeway/error.hpp"
 #include "test_util.hpp"
@@ -181,6 +184,98 @@ TEST_F(KinematicsTest, RejectsBadConfigurations) {
   q[2] = INFINITY;
   EXPECT_THROW(state.fk(q), InputError);
   EXPECT_THROW(solve_ik(state, {std::nan(""), 0, 1}, Eigen::VectorXd::Zero(6)), InputError);
+}
+
+// Every pose array of `a` equals `b`'s bit for bit (memcmp: -0.0 and NaN patterns included).
+void expect_same_poses(const mjModel& m, const mjData& a, const mjData& b, const std::string& what) {
+  auto same = [&](const mjtNum* x, const mjtNum* y, int n, const char* name) {
+    EXPECT_EQ(std::memcmp(x, y, sizeof(mjtNum) * static_cast<size_t>(n)), 0) << what << ": " << name;
+  };
+  same(a.xpos, b.xpos, 3 * m.nbody, "xpos");
+  same(a.xquat, b.xquat, 4 * m.nbody, "xquat");
+  same(a.xmat, b.xmat, 9 * m.nbody, "xmat");
+  same(a.xipos, b.xipos, 3 * m.nbody, "xipos");
+  same(a.ximat, b.ximat, 9 * m.nbody, "ximat");
+  same(a.xanchor, b.xanchor, 3 * m.njnt, "xanchor");
+  same(a.xaxis, b.xaxis, 3 * m.njnt, "xaxis");
+  same(a.geom_xpos, b.geom_xpos, 3 * m.ngeom, "geom_xpos");
+  same(a.geom_xmat, b.geom_xmat, 9 * m.ngeom, "geom_xmat");
+  same(a.site_xpos, b.site_xpos, 3 * m.nsite, "site_xpos");
+  same(a.site_xmat, b.site_xmat, 9 * m.nsite, "site_xmat");
+}
+
+// RobotState::set() updates only what moves; the result must be mj_kinematics's bit for bit, over
+// a sequence of configurations (nothing stale from the previous one).
+void expect_partial_kinematics_exact(const Scene& scene, int samples) {
+  const mjModel& m = scene.model();
+  RobotState state(scene);
+  DataPtr full = make_data(m);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const Eigen::VectorXd lo = scene.lower_limits(), hi = scene.upper_limits();
+  for (int k = 0; k < samples; ++k) {
+    Eigen::VectorXd q(scene.dof());
+    for (int i = 0; i < scene.dof(); ++i) q[i] = lo[i] + (hi[i] - lo[i]) * unit(rng);
+    state.set(q);
+    scene.set_qpos(*full, q);
+    mj_kinematics(&m, full.get());
+    expect_same_poses(m, state.data(), *full, scene.source() + " sample " + std::to_string(k));
+  }
+}
+
+TEST_F(KinematicsTest, PartialKinematicsIsMujocosOnEveryBundledCell) {
+  for (const char* cell : {"dallara", "baltico", "dlr", "example", "press_shop", "rail_hall", "shelf_bay"}) {
+    const Scene scene = Scene::load(workcell(cell));
+    // The moving part is the robot's links, not the cell: the obstacles stay out of it.
+    for (int g : scene.obstacle_geoms())
+      EXPECT_EQ(std::count(scene.moving_geoms().begin(), scene.moving_geoms().end(), g), 0) << cell;
+    for (int g : scene.link_geoms())
+      EXPECT_EQ(std::count(scene.moving_geoms().begin(), scene.moving_geoms().end(), g), 1) << cell;
+    EXPECT_EQ(std::count(scene.moving_sites().begin(), scene.moving_sites().end(), scene.tool_site()), 1)
+        << cell;
+    expect_partial_kinematics_exact(scene, 50);
+  }
+}
+
+TEST_F(KinematicsTest, PartialKinematicsCoversSlidesOffsetAnchorsAndFixedChildren) {
+  // A slide carrying a tilted body with two hinges on one body (the second off-centre), a
+  // joint-less child with a geom, a site and an off-centre inertia; a static body beside the robot
+  // with its own geoms and site; a mocap body. What moves is exactly the robot's subtree.
+  const std::string xml = R"(<mujoco model="partial">
+  <compiler angle="radian" autolimits="true"/>
+  <worldbody>
+    <geom name="wall" type="box" size="0.1 1 1" pos="3 0 1"/>
+    <body name="shelf" pos="-2 1 0" euler="0 0 0.3">
+      <geom name="board" type="box" size="0.5 0.2 0.02" pos="0 0 1"/>
+      <site name="goal" pos="0 0 1.1"/>
+    </body>
+    <body name="marker" mocap="true" pos="0 -2 1"><geom name="m" type="sphere" size="0.1"/></body>
+    <body name="carriage" pos="0 0 0.2" euler="0.1 0 0">
+      <joint name="rail" type="slide" axis="1 0.2 0" range="-1 2"/>
+      <geom name="cart" type="box" size="0.3 0.3 0.1"/>
+      <body name="arm" pos="0.1 0.2 0.3" quat="0.9 0.1 0.3 0.2">
+        <joint name="a" type="hinge" axis="0 0 1" pos="0.05 0 0" range="-3 3"/>
+        <joint name="b" type="hinge" axis="0 1 1" pos="0.2 -0.1 0.3" range="-2 2"/>
+        <inertial pos="0.3 0.1 0" quat="0.8 0.2 0.1 0.3" mass="2" diaginertia="0.1 0.2 0.3"/>
+        <geom name="upper" type="box" size="0.4 0.05 0.05" pos="0.4 0 0" euler="0.2 0.1 0"/>
+        <body name="flange" pos="0.8 0 0" euler="0 1.2 0">
+          <geom name="tool" type="capsule" size="0.03 0.1" pos="0 0 0.1"/>
+          <site name="tool0" pos="0 0 0.2" euler="0.3 0 0"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+)";
+  test::TempDir dir;
+  const Scene scene = Scene::load(dir.write("cell.xml", xml));
+  const mjModel& m = scene.model();
+  std::vector<std::string> bodies;
+  for (int b : scene.moving_bodies()) bodies.push_back(object_name(m, mjOBJ_BODY, b));
+  EXPECT_EQ(bodies, (std::vector<std::string>{"carriage", "arm", "flange"}));
+  EXPECT_EQ(scene.moving_geoms().size(), 3u);  // cart, upper, tool
+  EXPECT_EQ(scene.moving_sites(), std::vector<int>{mj_name2id(&m, mjOBJ_SITE, "tool0")});
+  expect_partial_kinematics_exact(scene, 200);
 }
 
 }  // namespace

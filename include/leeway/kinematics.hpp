@@ -34,13 +34,21 @@ struct Clearance {
   int obstacle_geom = -1;
 };
 
+//! MuJoCo's mj_kinematics for what moves with the robot joints only (Scene::moving_bodies() and
+//! their geoms and sites), with the same arithmetic in the same order, so the poses are bit for bit
+//! mj_kinematics's. Everything else in `d` must already hold a full mj_kinematics of the scene
+//! (nothing else moves: the robot's joints are the model's only joints). Its cost does not grow
+//! with the number of obstacles, mj_kinematics's does (all their geoms).
+void update_robot_kinematics(const Scene& scene, mjData& d);
+
 //! Forward kinematics and collision queries for one thread (it owns one mjData). Keeps a pointer to
 //! the Scene, which must outlive it.
 class RobotState {
  public:
   explicit RobotState(const Scene& scene);
 
-  //! Sets the robot joints and runs MuJoCo's kinematics. @throws InputError on a bad size or NaN.
+  //! Sets the robot joints and updates the poses (update_robot_kinematics()). @throws InputError on
+  //! a bad size or NaN.
   void set(const Eigen::VectorXd& q);
   //! Pose of the tool site at the configuration last passed to set().
   Pose tool_pose() const;

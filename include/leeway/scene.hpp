@@ -65,6 +65,11 @@ class Scene {
   Eigen::VectorXd lower_limits() const;
   Eigen::VectorXd upper_limits() const;
   int robot_root_body() const { return robot_root_; }
+  //! The bodies that move with the robot joints (a joint on them or on an ancestor), parents first,
+  //! and the geoms and sites on them: all that update_robot_kinematics() recomputes.
+  const std::vector<int>& moving_bodies() const { return moving_bodies_; }
+  const std::vector<int>& moving_geoms() const { return moving_geoms_; }
+  const std::vector<int>& moving_sites() const { return moving_sites_; }
 
   const std::vector<int>& link_geoms() const { return link_geoms_; }
   const std::vector<int>& base_geoms() const { return base_geoms_; }
@@ -105,6 +110,7 @@ class Scene {
   ModelPtr model_;
   std::vector<RobotJoint> joints_;
   int robot_root_ = -1;
+  std::vector<int> moving_bodies_, moving_geoms_, moving_sites_;
   std::vector<GeomRole> roles_;
   std::vector<int> link_geoms_, base_geoms_, obstacle_geoms_;
   int tool_site_ = -1;

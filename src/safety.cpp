@@ -19,12 +19,15 @@ constexpr double kTinyExtent = 1e-6;
 // Shrink steps one segment may take before it is reported as not certified.
 constexpr int kMaxShrinkSteps = 400;
 // Steps that regrow one shrunk extent toward its guide value: bisection against the probe, then
-// the certificate (its first step tries the probe's limit itself).
-constexpr int kProbeSteps = 6;
+// the certificate (the probe's limit, a thin slab an eighth of the way to it, bisection; on a short
+// segment the thin slab comes first).
+constexpr int kProbeSteps = 4;
 constexpr int kRegrowSteps = 4;
 // A slab (what one regrow step adds) gets this fraction of the leaf budget: a slab that needs more
-// is not worth its cost.
+// is not worth its cost. On a short segment (is_short) the first, thin slab is a cheap test of
+// whether growing is possible at all, which on dense paths fails in most cases: it gets less.
 constexpr long kSlabBudgetDivisor = 4;
+constexpr long kThinSlabBudgetDivisor = 16;
 // Random configurations a probe checks besides the corners.
 constexpr int kProbeSamples = 200;
 
@@ -41,6 +44,21 @@ struct Extents {
   Eigen::VectorXd lower(size_t k) const { return q[k] - below[k]; }
   Eigen::VectorXd upper(size_t k) const { return q[k] + above[k]; }
 };
+
+// A segment of a dense path: at every joint the guide's centre moves between its ends by at most a
+// twentieth of the guide's narrower half-width (plus 0.1 mrad or mm), so its region is one box
+// for the certificate, as it is for segment_free, which splits the path parameter only beyond
+// that motion.
+bool is_short(const Extents& guide, size_t a, size_t b) {
+  for (Eigen::Index i = 0; i < guide.q[a].size(); ++i) {
+    const double half =
+        std::min(guide.below[a][i] + guide.above[a][i], guide.below[b][i] + guide.above[b][i]) / 2;
+    const double motion =
+        std::abs((guide.upper(b)[i] + guide.lower(b)[i]) - (guide.upper(a)[i] + guide.lower(a)[i])) / 2;
+    if (motion > 0.05 * half + 1e-4) return false;
+  }
+  return true;
+}
 
 void halve(double& extent) { extent = extent / 2 < kTinyExtent ? 0.0 : extent / 2; }
 
@@ -118,7 +136,8 @@ SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& g
   // (p, r), k one of its ends, exactly the configurations whose joint i lies between the old and the
   // new bound: at each t a box, linear in t between the two ends (at the end other than k the
   // slab has zero width). That slab is itself a segment for the certificate, and a thin one.
-  auto slab_certified = [&](size_t p, size_t r, size_t k, int i, int side, double from, double to) {
+  auto slab_certified = [&](size_t p, size_t r, size_t k, int i, int side, double from, double to,
+                            long budget_divisor) {
     std::vector<Eigen::VectorXd> lo = {e.lower(p), e.lower(r)}, hi = {e.upper(p), e.upper(r)};
     for (size_t end = 0; end < 2; ++end) {
       const size_t x = end ? r : p;
@@ -134,12 +153,13 @@ SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& g
     }
     const CertifyOptions normal = certifier.options();
     CertifyOptions thin = normal;
-    thin.max_leaves = std::max(64L, normal.max_leaves / kSlabBudgetDivisor);
+    thin.max_leaves = std::max(64L, normal.max_leaves / budget_divisor);
     certifier.set_options(thin);
     const bool free = certifier.segment_free(lo[0], hi[0], lo[1], hi[1], stats, nullptr);
     certifier.set_options(normal);
     return free;
   };
+  const bool short_segment = is_short(guide, a, b);
   if (s.passed && s.shrink_steps > 0) {
     std::vector<size_t> ends = {a};
     if (b != a) ends.push_back(b);
@@ -167,24 +187,28 @@ SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& g
             }
           }
           // ... then the largest the certificate proves, between the shrunk value and that one:
-          // the probe's limit first, then an eighth of the way to it (when that small slab cannot
-          // be proven, the larger ones the bisection would try next are not either, almost always:
-          // a failing slab costs its whole leaf budget), then bisection.
+          // the probe's limit and a thin slab an eighth of the way to it (when the thin slab cannot
+          // be proven, the thicker ones are not either, almost always: the extent stays shrunk),
+          // then bisection. On a short segment the thin slab comes first, on a small budget: on
+          // dense paths it fails in most cases, and a failing slab costs its whole budget.
           const double probe_limit = ok;
           ok = shrunk_to;
           bad = probe_limit;
+          const int thin_step = short_segment ? 0 : 1, limit_step = 1 - thin_step;
           for (int step = 0; step < kRegrowSteps && bad - ok > kTinyExtent; ++step) {
-            extent = step == 0 ? bad : step == 1 ? ok + (bad - ok) / 8 : (ok + bad) / 2;
+            extent = step == limit_step ? bad : step == thin_step ? ok + (bad - ok) / 8 : (ok + bad) / 2;
+            const long divisor =
+                short_segment && step == thin_step ? kThinSlabBudgetDivisor : kSlabBudgetDivisor;
             // Only what the growth adds needs proving: the rest was proven with extent `ok`.
-            const bool pass = slab_certified(a, b, k, i, side, ok, extent) &&
-                              (!previous || slab_certified(a - 1, a, k, i, side, ok, extent)) &&
-                              (!next || slab_certified(b, b + 1, k, i, side, ok, extent));
+            const bool pass = slab_certified(a, b, k, i, side, ok, extent, divisor) &&
+                              (!previous || slab_certified(a - 1, a, k, i, side, ok, extent, divisor)) &&
+                              (!next || slab_certified(b, b + 1, k, i, side, ok, extent, divisor));
             if (pass) {
               ok = extent;
-              if (step == 0) break;
+              if (step == limit_step) break;
             } else {
               bad = extent;
-              if (step == 1) break;
+              if (step == thin_step) break;
             }
           }
           extent = ok;

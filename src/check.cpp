@@ -283,9 +283,15 @@ std::string to_text(const Scene& scene, const CheckReport& report) {
   for (size_t i = 0; i < scene.joints().size(); ++i) os << (i ? " " : "") << scene.joints()[i].name;
   os << "), " << scene.link_geoms().size() << " link geoms, " << scene.base_geoms().size()
      << " base geoms, tool site '" << object_name(m, mjOBJ_SITE, scene.tool_site()) << "'\n";
-  os << "obstacles: " << scene.obstacle_geoms().size() << " (";
-  for (size_t i = 0; i < scene.obstacle_geoms().size(); ++i)
-    os << (i ? ", " : "") << scene.geom_label(scene.obstacle_geoms()[i]);
+  // A crowded cell (thousands of obstacles) would print one line of thousands of names: the text
+  // names the first ones, --json lists every one.
+  constexpr size_t kListedObstacles = 20;
+  const auto& obstacles = scene.obstacle_geoms();
+  os << "obstacles: " << obstacles.size() << " (";
+  for (size_t i = 0; i < std::min(obstacles.size(), kListedObstacles); ++i)
+    os << (i ? ", " : "") << scene.geom_label(obstacles[i]);
+  if (obstacles.size() > kListedObstacles)
+    os << ", ... and " << obstacles.size() - kListedObstacles << " more: --json lists them all";
   os << ")\n";
   for (const auto& k : report.keyframes) {
     os << "keyframe " << k.name << ": tool at " << vec3(k.tool.position) << " m, ";

@@ -169,6 +169,12 @@ TEST_F(CheckTest, ObstacleOverlapsAreEveryOverlappingPairInIndexOrder) {
     if (scene_->role(o.geom_b) == GeomRole::kObstacle) got.emplace_back(o.geom_a, o.geom_b);
   EXPECT_GT(expected.size(), 50u);  // not vacuous
   EXPECT_EQ(got, expected);
+  // The text names the first 20 of the 400 and says how many it left out; the JSON has all.
+  const std::string text = to_text(*scene_, r);
+  EXPECT_THAT(text, HasSubstr("obstacles: 400 (o0, o1, "));
+  EXPECT_THAT(text, HasSubstr(", o19, ... and 380 more: --json lists them all)\n"));
+  EXPECT_EQ(text.find("o20,"), std::string::npos);
+  EXPECT_EQ(to_json(*scene_, r)["obstacles"].size(), 400u);
 }
 
 }  // namespace

@@ -46,16 +46,15 @@ struct Extents {
 };
 
 // A segment of a dense path: at every joint the guide's centre moves between its ends by at most a
-// twentieth of the guide's narrower half-width (plus 0.1 mrad or mm), so its region is one box
-// for the certificate, as it is for segment_free, which splits the path parameter only beyond
-// that motion.
+// twentieth of the guide's narrower half-width plus 5 mrad (or mm), so its region is about the box
+// at either end, and the boxes at its two ends are about the same.
 bool is_short(const Extents& guide, size_t a, size_t b) {
   for (Eigen::Index i = 0; i < guide.q[a].size(); ++i) {
     const double half =
         std::min(guide.below[a][i] + guide.above[a][i], guide.below[b][i] + guide.above[b][i]) / 2;
     const double motion =
         std::abs((guide.upper(b)[i] + guide.lower(b)[i]) - (guide.upper(a)[i] + guide.lower(a)[i])) / 2;
-    if (motion > 0.05 * half + 1e-4) return false;
+    if (motion > 0.05 * half + 0.005) return false;
   }
   return true;
 }
@@ -117,6 +116,24 @@ SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& g
     const std::vector<size_t> both = a == b ? std::vector<size_t>{a} : std::vector<size_t>{a, b};
     return (j >= 0 && (shrink(ends, j) || shrink(both, j))) || shrink(ends, -1) || shrink(both, -1);
   };
+  const bool short_segment = is_short(guide, a, b);
+  // Warm start: on a short segment whose end a was settled by the segment before it (an earlier
+  // phase) and whose end b is not settled yet, end b starts from end a's intervals where they are
+  // narrower than its guide's (clipped at its nominal value), and those are its regrow targets: a
+  // dense path's neighbouring waypoints need about the same intervals, and searching them again
+  // from the guide would repeat the failing proofs that settled end a.
+  Eigen::VectorXd target_below_b = guide.below[b], target_above_b = guide.above[b];
+  if (short_segment && check_previous && !check_next && a != b) {
+    const Eigen::VectorXd lower_a = e.lower(a), upper_a = e.upper(a), lower_b = e.lower(b),
+                          upper_b = e.upper(b);
+    for (int i = 0; i < n; ++i) {
+      // (Beyond rounding only: an untouched bound keeps its exact value.)
+      if (lower_a[i] > lower_b[i] + kTinyExtent) e.below[b][i] = std::max(0.0, e.q[b][i] - lower_a[i]);
+      if (upper_a[i] < upper_b[i] - kTinyExtent) e.above[b][i] = std::max(0.0, upper_a[i] - e.q[b][i]);
+    }
+    target_below_b = e.below[b];
+    target_above_b = e.above[b];
+  }
   while (s.shrink_steps < kMaxShrinkSteps) {
     CertifyFailure f;
     if (probed(a, b, &f) && certified(a, b, &f)) {
@@ -159,7 +176,6 @@ SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& g
     certifier.set_options(normal);
     return free;
   };
-  const bool short_segment = is_short(guide, a, b);
   if (s.passed && s.shrink_steps > 0) {
     std::vector<size_t> ends = {a};
     if (b != a) ends.push_back(b);
@@ -167,7 +183,9 @@ SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& g
       for (size_t k : ends)
         for (int side = 0; side < 2; ++side) {
           double& extent = side ? e.above[k][i] : e.below[k][i];
-          const double shrunk_to = extent, guide_extent = side ? guide.above[k][i] : guide.below[k][i];
+          const double shrunk_to = extent,
+                       guide_extent = k == b ? (side ? target_above_b[i] : target_below_b[i])
+                                             : (side ? guide.above[k][i] : guide.below[k][i]);
           if (!(guide_extent > shrunk_to)) continue;
           const bool previous = check_previous && k == a, next = check_next && k == b && a != b;
           // The largest extent the probe does not reject, by bisection (cheap) ...

@@ -81,6 +81,27 @@ TEST_F(OneLinkSafetyTest, CertifiedShrinksOnlyTheSideThatHitsTheWall) {
   EXPECT_EQ(bounds[1].lower[0], -0.2);
 }
 
+TEST_F(OneLinkSafetyTest, ADensePathIsCertifiedAsWideAsATwoWaypointOne) {
+  // 61 waypoints 5 mrad apart, nominal 0 .. 0.3 rad, guide up to 2.0 rad through the wall: every
+  // segment is short, so the regrow tries thin slabs first and waypoints after the first phase
+  // start from their neighbour's bounds. The result must be as sound as the two-waypoint path's
+  // and as wide (the touch angle does not depend on the waypoint), for one thread and for two.
+  std::vector<WaypointBounds> dense;
+  for (int k = 0; k <= 60; ++k) dense.push_back(box_around(0.005 * k, -0.5, 2.0));
+  std::vector<WaypointBounds> two_threads = dense;
+  const SafetyReport r = make_safe(*scene_, dense, SafetyParams{}, CertifyBound::kTaylor, 1);
+  make_safe(*scene_, two_threads, SafetyParams{}, CertifyBound::kTaylor, 2);
+  ASSERT_EQ(r.segments.size(), 60u);
+  EXPECT_TRUE(r.all_passed);
+  for (size_t k = 0; k < dense.size(); ++k) {
+    SCOPED_TRACE(k);
+    EXPECT_LE(dense[k].upper[0], kTouch - kWithinMargin + 1e-9);
+    EXPECT_GE(dense[k].upper[0], kTouch - 0.15);
+    EXPECT_EQ(dense[k].lower[0], -0.5);  // the free side untouched
+    EXPECT_EQ(dense[k].upper[0], two_threads[k].upper[0]);
+  }
+}
+
 TEST_F(OneLinkSafetyTest, NoneLeavesTheBoundsAsTheyAre) {
   std::vector<WaypointBounds> bounds = {box_around(0.0, -0.5, 2.0), box_around(0.3, -0.2, 2.0)};
   SafetyParams p;

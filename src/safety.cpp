@@ -28,6 +28,9 @@ constexpr int kRegrowSteps = 4;
 // whether growing is possible at all, which on dense paths fails in most cases: it gets less.
 constexpr long kSlabBudgetDivisor = 4;
 constexpr long kThinSlabBudgetDivisor = 16;
+// Phases of a dense path's segments (three otherwise): segments this far apart run in parallel,
+// the ones between them in order, each starting from its settled neighbour (warm start).
+constexpr size_t kDensePhases = 16;
 // Random configurations a probe checks besides the corners.
 constexpr int kProbeSamples = 200;
 
@@ -303,20 +306,25 @@ SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, 
     options.bound = bound;
     const Extents guide(bounds);
     // Segment s writes waypoints s and s + 1 and, regrowing them, reads its neighbours' (s - 1 and
-    // s + 2): segments three apart share nothing, so the segments with s % 3 == phase run in
+    // s + 2): segments three apart share nothing, so the segments with s % phases == phase run in
     // parallel, phase by phase. A regrown waypoint must keep the neighbour that shares it certified
     // when that neighbour's phase came earlier. The order does not depend on the thread count.
     report.segments.assign(segments, SegmentSafety{});
     std::vector<CertifyStats> stats(segments);
-    for (size_t phase = 0; phase < 3; ++phase) {
+    // A dense path (at least half its segments short) takes kDensePhases phases: every segment but
+    // those of phase 0 then has a settled neighbour to start warm from.
+    size_t short_count = 0;
+    for (size_t s = 0; s + 1 < bounds.size(); ++s) short_count += is_short(guide, s, s + 1) ? 1 : 0;
+    const size_t phases = 2 * short_count >= segments && segments > 1 ? kDensePhases : 3;
+    for (size_t phase = 0; phase < phases; ++phase) {
       std::vector<size_t> jobs;
-      for (size_t s = phase; s < segments; s += 3) jobs.push_back(s);
+      for (size_t s = phase; s < segments; s += phases) jobs.push_back(s);
       detail::parallel_for(static_cast<int>(jobs.size()), threads, [&] {
         auto certifier = std::make_shared<Certifier>(scene, options);
         return [&, certifier](int i) {
           const size_t s = jobs[static_cast<size_t>(i)];
           const bool previous = s > 0 && phase > 0;
-          const bool next = s + 1 < segments && phase == 2;
+          const bool next = s + 1 < segments && phase == phases - 1;
           report.segments[s] = certify_segment(*certifier, e, guide, s, std::min(s + 1, bounds.size() - 1),
                                                previous, next, stats[s]);
         };

@@ -232,17 +232,21 @@ void Scene::recognise(const SceneOptions& options) {
   mj_kinematics(&m, d.get());
   // Every collidable geom's size and pose must be finite numbers of workcell scale: MuJoCo compiles
   // NaN and inf, and the collision checks would then answer nonsense.
+  auto refuse_values = [&](const std::string& element, const char* what, const mjtNum* v, int n, double limit,
+                           const char* unit) {
+    for (int i = 0; i < n; ++i)
+      if (!std::isfinite(v[i]) || std::abs(v[i]) > limit) {
+        std::string values;
+        for (int k = 0; k < n; ++k) values += (k ? " " : "") + format_number(v[k]);
+        throw InputError(file + ": " + element + " " + what + " '" + values + "'" + unit +
+                         (std::isfinite(v[i]) ? " goes beyond +-" + format_number(limit) + unit
+                                              : std::string(" is not finite")));
+      }
+  };
   for (int g = 0; g < m.ngeom; ++g) {
     if (roles_[static_cast<size_t>(g)] == GeomRole::kIgnored) continue;
     auto refuse = [&](const char* what, const mjtNum* v, int n, double limit, const char* unit) {
-      for (int i = 0; i < n; ++i)
-        if (!std::isfinite(v[i]) || std::abs(v[i]) > limit) {
-          std::string values;
-          for (int k = 0; k < n; ++k) values += (k ? " " : "") + format_number(v[k]);
-          throw InputError(file + ": geom '" + geom_label(g) + "' " + what + " '" + values + "'" + unit +
-                           (std::isfinite(v[i]) ? " goes beyond +-" + format_number(limit) + unit
-                                                : std::string(" is not finite")));
-        }
+      refuse_values("geom '" + geom_label(g) + "'", what, v, n, limit, unit);
     };
     refuse("size", m.geom_size + 3 * g, 3, kMaxLength, " m");
     refuse("pos", m.geom_pos + 3 * g, 3, kMaxLength, " m");
@@ -253,6 +257,16 @@ void Scene::recognise(const SceneOptions& options) {
     // undefined behaviour, an inf one made every geom touch (issue 14's fuzzing; fuzz/regressions/cell/).
     refuse("margin", m.geom_margin + g, 1, kMaxLength, " m");
     refuse("gap", m.geom_gap + g, 1, kMaxLength, " m");
+  }
+  // The tool site and the goal sites likewise: a NaN site gave NaN tool poses and goals.
+  std::vector<int> sites = goal_sites_;
+  sites.push_back(tool_site_);
+  for (int i : sites) {
+    const std::string element = "site '" + object_name(m, mjOBJ_SITE, i) + "'";
+    refuse_values(element, "pos", m.site_pos + 3 * i, 3, kMaxLength, " m");
+    refuse_values(element, "quat", m.site_quat + 4 * i, 4, 2.0, "");
+    refuse_values(element, "world position", d->site_xpos + 3 * i, 3, kMaxLength, " m");
+    refuse_values(element, "world orientation", d->site_xmat + 9 * i, 9, 2.0, "");
   }
   std::vector<int> statics;
   for (int g = 0; g < m.ngeom; ++g)

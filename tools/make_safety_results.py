@@ -35,13 +35,14 @@ NEW_PATHS = [("press_shop", "home", "pick"), ("press_shop", "pick", "place"), ("
 CONFIGS = [("thesis", ["--preset", "thesis"]), ("guide", ["--safety", "none"]), ("leeway", [])]
 
 
-def widths(bounds):
-    """Mean width of the bisected joints (j1-j3) and of all joints [rad, m], and shrunk intervals."""
+def widths(bounds, prefix=""):
+    """Mean width of the bisected joints (j1-j3) and of all joints [rad, m], and shrunk intervals.
+    prefix "guide_": the widths of the guide intervals the file records beside the bounds."""
     kinds = bounds["joint_bounding"]
     bis, every, shrunk, total = [], [], 0, 0
     for w in bounds["waypoints"]:
         for i, kind in enumerate(kinds):
-            width = w["upper"][i] - w["lower"][i]
+            width = w[prefix + "upper"][i] - w[prefix + "lower"][i]
             every.append(width)
             if kind == "bisected":
                 bis.append(width)

@@ -4,8 +4,8 @@
   1. `leeway bounds CELL --path P` on a joint-linear path file of N waypoints (default 1,000) at
      default settings (leeway preset, certified safety stage, all hardware threads); target <= 30 s.
      The path runs between two keyframes of a bundled cell (--path-case CELL:FROM:TO; default: two
-   thesis cells and two of the cells built for judging). The table gives the certified j1-j3 width
-   beside the time: a faster safety stage must not be a narrower one.
+     thesis cells and two of the cells built for judging). The table gives the certified j1-j3
+     width beside the time: a faster safety stage must not be a narrower one.
   2. `leeway check` on a cell with 20,000 extra obstacles (4 x 4 x 20 cm boxes at seeded random
      places over 8 x 8 m, overlaps included); target <= 5 s.
 
@@ -29,6 +29,7 @@ import time
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tools"))
 from machine_info import cpu_of_children, machine  # noqa: E402
+from make_safety_results import widths  # noqa: E402
 
 
 def timed(cmd, ok=(0,)):
@@ -108,9 +109,8 @@ def main():
                     for _ in range(args.repeats)]
             d = json.loads(out.read_text())
             s = d["safety"]
-            width = statistics.mean(w["upper"][j] - w["lower"][j] for w in d["waypoints"] for j in range(3))
-            guide = statistics.mean(w["guide_upper"][j] - w["guide_lower"][j] for w in d["waypoints"]
-                                    for j in range(3))
+            # The bisected joints' widths (j1-j3, whatever joints come before them, such as a rail).
+            width, guide = widths(d)[0], widths(d, "guide_")[0]
             note = (f"{len(d['waypoints'])} waypoints, {'certified' if s['certified'] else 'NOT certified'}, "
                     f"{s['leaves']} leaves; mean j1-j3 width {width:.3f} rad, {100 * width / guide:.1f} % of "
                     f"the guide's")

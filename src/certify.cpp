@@ -129,7 +129,10 @@ bool Certifier::leaf_free(const Eigen::VectorXd& lower, const Eigen::VectorXd& u
 }
 
 // One leaf: every pair in `pairs` is tested at the box's centre c with half-widths h; on return
-// `pairs` holds the pairs that could not be separated (empty: the box is free).
+// `pairs` holds the pairs that could not be separated (empty: the box is free). (Stopping at the
+// first such pair was tried: 15 % less CPU on a dense shelf_bay path, but the worst-first order
+// below then follows the first failing pair instead of the worst, and the certified widths fell:
+// the 15 sparse paths' mean certified/guide j1-j3 width from 0.791 to 0.761.)
 bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
                                std::vector<int>& pairs, CertifyStats& stats, CertifyFailure* failure,
                                const Eigen::VectorXd* blame) {
@@ -152,8 +155,9 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
     failure->gap = 0.0;
   }
 
-  // Per link (computed when its first pair comes up): world box at c, joint Jacobian columns at the
-  // box centre, derivatives of the box axes, and the remainders.
+  // Per link (computed when its first pair comes up): world box at c and an isotropic bound; when a
+  // pair needs more (built once per link and leaf): joint Jacobian columns at the box centre,
+  // derivatives of the box axes, and the remainders.
   Box box;
   thread_local std::vector<Eigen::Vector3d> jac;       // d x / d q_i at c
   thread_local std::vector<Eigen::Matrix3d> axis_jac;  // column k: d e_k / d q_i at c
@@ -170,13 +174,18 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
   thread_local std::vector<Term> terms;
   bool terms_ready = false;
   thread_local std::vector<double> r_pos,
-      r_rot;                            // per joint p: the remainder terms (p, q >= p) with |n x a_p| = 1
-  thread_local std::vector<double> dv;  // per joint q: |v_q(q) - v_q(c)|, see below
-  size_t link_n = 0;                    // the current link's joint count, ...
-  double link_theta = 0;                // ... the rotation all its hinges can give, ...
-  int link_index = 0;                   // ... and its index in links_
-  double iso = 0;                       // radius of a sphere around x(c) holding the swept link
-  double lever_radius = 0;              // the loose reference's inflation
+      r_rot;                             // per joint p: the remainder terms (p, q >= p) with |n x a_p| = 1
+  thread_local std::vector<double> dv;   // per joint q: |v_q(q) - v_q(c)|, see below
+  size_t link_n = 0;                     // the current link's joint count, ...
+  double link_theta = 0;                 // ... the rotation all its hinges can give, ...
+  int link_index = 0;                    // ... and its index in links_
+  double iso = 0;                        // radius of a sphere around x(c) holding the swept link
+  double iso_cheap = 0;                  // a larger one, without the Jacobian
+  double rem_iso = 0;                    // the remainder's isotropic size
+  bool link_ready = false;               // the current link's bound is built
+  thread_local Eigen::Matrix3Xd motion;  // see below
+  Eigen::Index motion_cols = 0;
+  double lever_radius = 0;  // the loose reference's inflation
 
   auto build_terms = [&] {
     const size_t n = link_n;
@@ -218,6 +227,36 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
     if (li != last_link) {
       last_link = li;
       box = geom_box(m, d, link.geom);
+      link_ready = false;
+      // The remainder's isotropic size, and a sphere around x(c) that holds the swept link without
+      // the Jacobian (|d x / d q_p| <= lever_p, 1 for a slide): most pairs are separated by it, and
+      // the link's full bound below is built only for the pairs it does not separate.
+      const size_t n = link.joints.size();
+      rem_iso = 0;
+      r_pos.assign(n, 0.0);
+      r_rot.assign(n, 0.0);
+      iso_cheap = box.half_size.norm();
+      for (size_t p = 0; p < n; ++p) {
+        const int rp = link.joints[p];
+        const bool slide_p = prismatic_[static_cast<size_t>(rp)];
+        iso_cheap += h[rp] * (slide_p ? 1.0 : link.lever[p]);
+        if (slide_p) continue;
+        for (size_t q = p; q < n; ++q) {
+          const int rq = link.joints[q];
+          const bool slide = prismatic_[static_cast<size_t>(rq)];
+          const double coef = (p == q ? 0.5 : 1.0) * h[rp] * h[rq];
+          r_pos[p] += coef * (slide ? 1.0 : link.lever[q]);
+          if (!slide) r_rot[p] += coef;
+        }
+        rem_iso += r_pos[p];
+      }
+      iso_cheap += rem_iso;
+    }
+    if (options_.bound == CertifyBound::kTaylor && !obs.plane &&
+        (obs.box.center - box.center).norm() - iso_cheap - obs.radius > margin)
+      continue;
+    if (!link_ready) {
+      link_ready = true;
       const size_t n = link.joints.size();
       jac.assign(n, Eigen::Vector3d::Zero());
       axis_jac.assign(n, Eigen::Matrix3d::Zero());
@@ -265,29 +304,25 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
           dv[q] += h[rr] * (prismatic_[static_cast<size_t>(rr)] ? 1.0 : link.lever[r]);
         }
       }
-      // The remainder's isotropic size (for the sphere test); its terms are built only for pairs
-      // that the sphere test does not separate.
-      double rem_iso = 0;
-      r_pos.assign(n, 0.0);
-      r_rot.assign(n, 0.0);
-      for (size_t p = 0; p < n; ++p) {
-        const int rp = link.joints[p];
-        if (prismatic_[static_cast<size_t>(rp)]) continue;
-        for (size_t q = p; q < n; ++q) {
-          const int rq = link.joints[q];
-          const bool slide = prismatic_[static_cast<size_t>(rq)];
-          const double coef = (p == q ? 0.5 : 1.0) * h[rp] * h[rq];
-          r_pos[p] += coef * (slide ? 1.0 : link.lever[q]);
-          if (!slide) r_rot[p] += coef;
-        }
-        rem_iso += r_pos[p];
-      }
+      // The remainder's terms are built only for pairs that the sphere test does not separate.
       terms_ready = false;
       link_n = n;
       link_theta = theta;
       link_index = li;
       iso = rem_iso + box.half_size.norm();
       for (size_t p = 0; p < n; ++p) iso += h[link.joints[p]] * jac[p].norm();
+      // The first-order motion's directions, scaled by the half-widths: first(n, h) below is the
+      // sum of |n . column|.
+      motion.resize(3, static_cast<Eigen::Index>(4 * n));
+      Eigen::Index col = 0;
+      for (size_t p = 0; p < n; ++p) {
+        const double hp = h[link.joints[p]];
+        if (hp == 0) continue;
+        motion.col(col++) = hp * jac[p];
+        if (prismatic_[static_cast<size_t>(link.joints[p])]) continue;
+        for (int k = 0; k < 3; ++k) motion.col(col++) = (hp * box.half_size[k]) * axis_jac[p].col(k);
+      }
+      motion_cols = col;
     }
 
     bool separated = false;
@@ -342,7 +377,8 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
     // Whether the pair is separated on axis n given the signed distance `apart` between the
     // link's centre and the obstacle's near face along n, with the obstacle's extent removed.
     auto separated_on = [&](const Eigen::Vector3d& nrm, double apart) {
-      const double base = apart - first(nrm, h) - extent(nrm);
+      const double base =
+          apart - (motion.leftCols(motion_cols).transpose() * nrm).cwiseAbs().sum() - extent(nrm);
       // The refined remainder only where the cheap one fails and the rest leaves room; the gap of
       // an axis (for the blame and the search order) is its best bound either way.
       double g = base - rem_cheap(nrm);

@@ -31,6 +31,11 @@ constexpr long kThinSlabBudgetDivisor = 16;
 // Phases of a dense path's segments (three otherwise): segments this far apart run in parallel,
 // the ones between them in order, each starting from its settled neighbour (warm start).
 constexpr size_t kDensePhases = 16;
+// On a dense path, every this many segments (and where the guide changes between a segment's ends,
+// see guide_steady), a warm-started segment regrows its end b toward the guide even when it needed
+// no shrinking: warm starts only narrow, and this lets the intervals widen again where the path
+// leaves the obstacles, between cold segments.
+constexpr size_t kWidenEvery = 4;
 // Random configurations a probe checks besides the corners.
 constexpr int kProbeSamples = 200;
 
@@ -48,10 +53,22 @@ struct Extents {
   Eigen::VectorXd upper(size_t k) const { return q[k] + above[k]; }
 };
 
-// A segment of a dense path: at every joint the guide's centre moves between its ends by at most a
+// A segment of a dense path: at every joint the nominal value moves between its ends by at most a
 // twentieth of the guide's narrower half-width plus 5 mrad (or mm), so its region is about the box
-// at either end, and the boxes at its two ends are about the same.
+// at either end, and the boxes at its two ends can be about the same.
 bool is_short(const Extents& guide, size_t a, size_t b) {
+  for (Eigen::Index i = 0; i < guide.q[a].size(); ++i) {
+    const double half =
+        std::min(guide.below[a][i] + guide.above[a][i], guide.below[b][i] + guide.above[b][i]) / 2;
+    if (std::abs(guide.q[b][i] - guide.q[a][i]) > 0.05 * half + 0.005) return false;
+  }
+  return true;
+}
+
+// The guide's intervals at the two ends are about the same: their centres move by as little as
+// is_short's nominal values. (The guide of the thesis's bisection can jump between neighbouring
+// waypoints of a dense path.)
+bool guide_steady(const Extents& guide, size_t a, size_t b) {
   for (Eigen::Index i = 0; i < guide.q[a].size(); ++i) {
     const double half =
         std::min(guide.below[a][i] + guide.above[a][i], guide.below[b][i] + guide.above[b][i]) / 2;
@@ -121,12 +138,21 @@ SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& g
   };
   const bool short_segment = is_short(guide, a, b);
   // Warm start: on a short segment whose end a was settled by the segment before it (an earlier
-  // phase) and whose end b is not settled yet, end b starts from end a's intervals where they are
-  // narrower than its guide's (clipped at its nominal value), and those are its regrow targets: a
-  // dense path's neighbouring waypoints need about the same intervals, and searching them again
-  // from the guide would repeat the failing proofs that settled end a.
+  // phase), end b starts from end a's intervals where they are narrower than its own (clipped at
+  // its nominal value), and those are its regrow targets: a dense path's neighbouring waypoints
+  // need about the same intervals, and searching them again from the guide would repeat the
+  // failing proofs that settled end a. When end b was settled too (by the segment after it), it
+  // is narrowed the same way, and end a's regrow target is its settled value: each end's own
+  // search is over. A segment that widens (kWidenEvery) keeps the guide as end b's target.
+  Eigen::VectorXd target_below_a = guide.below[a], target_above_a = guide.above[a];
   Eigen::VectorXd target_below_b = guide.below[b], target_above_b = guide.above[b];
-  if (short_segment && check_previous && !check_next && a != b) {
+  const bool warm = short_segment && check_previous && a != b;
+  const bool widen_b = warm && !check_next && (a % kWidenEvery == 0 || !guide_steady(guide, a, b));
+  if (warm && check_next) {
+    target_below_a = e.below[a];
+    target_above_a = e.above[a];
+  }
+  if (warm) {
     const Eigen::VectorXd lower_a = e.lower(a), upper_a = e.upper(a), lower_b = e.lower(b),
                           upper_b = e.upper(b);
     for (int i = 0; i < n; ++i) {
@@ -134,8 +160,10 @@ SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& g
       if (lower_a[i] > lower_b[i] + kTinyExtent) e.below[b][i] = std::max(0.0, e.q[b][i] - lower_a[i]);
       if (upper_a[i] < upper_b[i] - kTinyExtent) e.above[b][i] = std::max(0.0, upper_a[i] - e.q[b][i]);
     }
-    target_below_b = e.below[b];
-    target_above_b = e.above[b];
+    if (!widen_b) {
+      target_below_b = e.below[b];
+      target_above_b = e.above[b];
+    }
   }
   while (s.shrink_steps < kMaxShrinkSteps) {
     CertifyFailure f;
@@ -179,8 +207,10 @@ SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& g
     certifier.set_options(normal);
     return free;
   };
-  if (s.passed && s.shrink_steps > 0) {
-    std::vector<size_t> ends = {a};
+  if (s.passed && (s.shrink_steps > 0 || widen_b)) {
+    // (Without a shrink, only a widening end b has something to regrow.)
+    std::vector<size_t> ends;
+    if (s.shrink_steps > 0) ends.push_back(a);
     if (b != a) ends.push_back(b);
     for (int i = 0; i < n; ++i)
       for (size_t k : ends)
@@ -188,7 +218,7 @@ SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& g
           double& extent = side ? e.above[k][i] : e.below[k][i];
           const double shrunk_to = extent,
                        guide_extent = k == b ? (side ? target_above_b[i] : target_below_b[i])
-                                             : (side ? guide.above[k][i] : guide.below[k][i]);
+                                             : (side ? target_above_a[i] : target_below_a[i]);
           if (!(guide_extent > shrunk_to)) continue;
           const bool previous = check_previous && k == a, next = check_next && k == b && a != b;
           // The largest extent the probe does not reject, by bisection (cheap) ...

@@ -102,6 +102,38 @@ TEST_F(OneLinkSafetyTest, ADensePathIsCertifiedAsWideAsATwoWaypointOne) {
   }
 }
 
+TEST_F(OneLinkSafetyTest, ADensePathWidensAgainWhereItsGuideWidens) {
+  // The nominal as above (61 waypoints, 5 mrad apart), but the guide's upper side is only 5 cm
+  // above the nominal up to waypoint 21 (all free: at most 0.155 rad) and 2.0 rad (through the
+  // wall) from waypoint 22 on. A warm start copies a neighbour's absolute bound where it is
+  // narrower, so without widening the early, narrow bounds would be carried along the path:
+  // waypoint 15 would keep 0.05 rad (its guide: 0.125), and waypoints 22-32 about 0.155 rad where
+  // everything up to the touch angle minus the margin is free.
+  std::vector<WaypointBounds> dense;
+  for (int k = 0; k <= 60; ++k) {
+    const double q = 0.005 * k;
+    dense.push_back(box_around(q, -0.5, k <= 21 ? q + 0.05 : 2.0));
+  }
+  const std::vector<WaypointBounds> guide = dense;
+  std::vector<WaypointBounds> two_threads = dense;
+  const SafetyReport r = make_safe(*scene_, dense, SafetyParams{}, CertifyBound::kTaylor, 1);
+  make_safe(*scene_, two_threads, SafetyParams{}, CertifyBound::kTaylor, 2);
+  EXPECT_TRUE(r.all_passed);
+  for (size_t k = 0; k < dense.size(); ++k) {
+    SCOPED_TRACE(k);
+    EXPECT_LE(dense[k].upper[0], kTouch - kWithinMargin + 1e-9);
+    if (k <= 21) {
+      // Every fourth segment widens its end toward the guide: at most four 5 mrad steps behind it.
+      EXPECT_GE(dense[k].upper[0], guide[k].upper[0] - 4 * 0.005 - 1e-9);
+    } else {
+      // Where the guide jumps, at once.
+      EXPECT_GE(dense[k].upper[0], kTouch - 0.15);
+    }
+    EXPECT_EQ(dense[k].lower[0], -0.5);
+    EXPECT_EQ(dense[k].upper[0], two_threads[k].upper[0]);
+  }
+}
+
 TEST_F(OneLinkSafetyTest, NoneLeavesTheBoundsAsTheyAre) {
   std::vector<WaypointBounds> bounds = {box_around(0.0, -0.5, 2.0), box_around(0.3, -0.2, 2.0)};
   SafetyParams p;

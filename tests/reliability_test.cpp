@@ -248,6 +248,30 @@ TEST(Mjb, CellsWorkInCheckAndBounds) {
   EXPECT_EQ(bounds.exit_code, 0) << bounds.out;
 }
 
+// Defect 9: `bounds` searched the cell's text for "</worldbody>" to place its volume body, so a
+// comment holding that tag after the world body made a valid cell fail. The cell is now compiled
+// once and the volume model built from the compiled scene: the comment changes nothing.
+TEST(ValidCells, AWorldBodyEndTagInACommentIsJustAComment) {
+  test::TempDir dir;
+  std::string text = read_text(kCorpus + "/cells/ok.xml");
+  const size_t end = text.find("</worldbody>");
+  ASSERT_NE(end, std::string::npos);
+  text.insert(end + std::string("</worldbody>").size(), "\n  <!-- the world body ends with </worldbody> -->");
+  const std::string commented = dir.write("commented.xml", text);
+  const std::string plain_out = (dir.path() / "plain.json").string(),
+                    commented_out = (dir.path() / "commented.json").string();
+  const auto plain = test::run_cli("bounds " + kCorpus +
+                                   "/cells/ok.xml --from a --to b --safety none --json --out " + plain_out);
+  const auto with_comment =
+      test::run_cli("bounds " + commented + " --from a --to b --safety none --json --out " + commented_out);
+  ASSERT_EQ(plain.exit_code, 0) << plain.out;
+  ASSERT_EQ(with_comment.exit_code, 0) << with_comment.out;
+  const auto a = nlohmann::json::parse(read_text(plain_out)),
+             b = nlohmann::json::parse(read_text(commented_out));
+  EXPECT_EQ(a["waypoints"], b["waypoints"]);
+  EXPECT_EQ(a["boxes"], b["boxes"]);
+}
+
 // SIGINT during leeway-tune's calibration keeps an existing --log as it was.
 TEST(Tune, InterruptedCalibrationKeepsTheLog) {
   test::TempDir dir;

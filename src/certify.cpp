@@ -313,7 +313,9 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
       for (size_t p = 0; p < n; ++p) iso += h[link.joints[p]] * jac[p].norm();
       // The first-order motion's directions, scaled by the half-widths: first(n, h) below is the
       // sum of |n . column|.
-      motion.resize(3, static_cast<Eigen::Index>(4 * n));
+      // (It only grows: resizing to another size would allocate.)
+      if (motion.cols() < static_cast<Eigen::Index>(4 * n))
+        motion.resize(3, static_cast<Eigen::Index>(4 * n));
       Eigen::Index col = 0;
       for (size_t p = 0; p < n; ++p) {
         const double hp = h[link.joints[p]];

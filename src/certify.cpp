@@ -331,12 +331,12 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
     // The axis on which the pair came closest to separating, for the blame below.
     Eigen::Vector3d best_axis = (obs.box.center - box.center).normalized();
     double best_gap = -std::numeric_limits<double>::infinity();
-    // Projected radius of the swept link on a unit axis (the Taylor bound), with weights w per
-    // joint: h for the bound itself; the blame uses other weights.
     // The swept link's projected radius on a unit axis n is first(n, h) + extent(n) + a remainder;
     // first() and extent() are the first-order motion and the box at c, and the remainder is
     // bounded cheaply (s_p(n) times every term's isotropic bound) or refined (per term, the
-    // smaller of that and its value at c plus its variation), see above.
+    // smaller of that and its value at c plus its variation), see above. first(n, h) is evaluated
+    // as the sum of |n . column| of `motion` (the same terms, scaled once per link); first() with
+    // other weights w per joint serves the blame below (a probe's offsets, where h is zero).
     auto first = [&](const Eigen::Vector3d& nrm, const Eigen::VectorXd& w) {
       double r = 0;
       for (size_t p = 0; p < jac.size(); ++p) {

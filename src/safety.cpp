@@ -53,30 +53,30 @@ struct Extents {
   Eigen::VectorXd upper(size_t k) const { return q[k] + above[k]; }
 };
 
-// A segment of a dense path: at every joint the nominal value moves between its ends by at most a
-// twentieth of the guide's narrower half-width plus 5 mrad (or mm), so its region is about the box
-// at either end, and the boxes at its two ends can be about the same.
-bool is_short(const Extents& guide, size_t a, size_t b) {
-  for (Eigen::Index i = 0; i < guide.q[a].size(); ++i) {
+// At every joint, the point `from` (at waypoint a) and `to` (at waypoint b) are at most a twentieth
+// of the guide's narrower half-width plus 5 mrad (or mm) apart.
+bool moves_little(const Extents& guide, size_t a, size_t b, const Eigen::VectorXd& from,
+                  const Eigen::VectorXd& to) {
+  for (Eigen::Index i = 0; i < from.size(); ++i) {
     const double half =
         std::min(guide.below[a][i] + guide.above[a][i], guide.below[b][i] + guide.above[b][i]) / 2;
-    if (std::abs(guide.q[b][i] - guide.q[a][i]) > 0.05 * half + 0.005) return false;
+    if (std::abs(to[i] - from[i]) > 0.05 * half + 0.005) return false;
   }
   return true;
+}
+
+// A segment of a dense path: the nominal value moves little between its ends (moves_little), so its
+// region is about the box at either end, and the boxes at its two ends can be about the same.
+bool is_short(const Extents& guide, size_t a, size_t b) {
+  return moves_little(guide, a, b, guide.q[a], guide.q[b]);
 }
 
 // The guide's intervals at the two ends are about the same: their centres move by as little as
 // is_short's nominal values. (The guide of the thesis's bisection can jump between neighbouring
 // waypoints of a dense path.)
 bool guide_steady(const Extents& guide, size_t a, size_t b) {
-  for (Eigen::Index i = 0; i < guide.q[a].size(); ++i) {
-    const double half =
-        std::min(guide.below[a][i] + guide.above[a][i], guide.below[b][i] + guide.above[b][i]) / 2;
-    const double motion =
-        std::abs((guide.upper(b)[i] + guide.lower(b)[i]) - (guide.upper(a)[i] + guide.lower(a)[i])) / 2;
-    if (motion > 0.05 * half + 0.005) return false;
-  }
-  return true;
+  return moves_little(guide, a, b, (guide.lower(a) + guide.upper(a)) / 2,
+                      (guide.lower(b) + guide.upper(b)) / 2);
 }
 
 void halve(double& extent) { extent = extent / 2 < kTinyExtent ? 0.0 : extent / 2; }

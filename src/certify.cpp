@@ -6,6 +6,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <tuple>
 
 #include "leeway/error.hpp"
 
@@ -117,7 +118,48 @@ Certifier::Certifier(const Scene& scene, CertifyOptions options)
     o.radius = o.plane ? INFINITY : o.box.half_size.norm();
     obstacles_.push_back(o);
   }
-  all_pairs_.resize(links_.size() * obstacles_.size());
+  // Self pairs: the geom on the later part moves against the other (docs/algorithm.md,
+  // "Self-collision"). `shared` counts the link's joints at or above the two geoms' deepest common
+  // body: they move both geoms rigidly, so they do not change the pair's distance.
+  std::vector<int> link_of(static_cast<size_t>(m.ngeom), -1);
+  for (size_t i = 0; i < links_.size(); ++i) link_of[static_cast<size_t>(links_[i].geom)] = static_cast<int>(i);
+  auto chain = [&](int body) {
+    std::vector<int> out;
+    for (int b = body; b > 0; b = m.body_parentid[b]) out.push_back(b);
+    return out;
+  };
+  auto shared_joints = [&](const Link& link, const std::vector<int>& common) {
+    int n = 0;
+    for (int r : link.joints) {
+      const int body = m.jnt_bodyid[scene.joints()[static_cast<size_t>(r)].id];
+      if (std::find(common.begin(), common.end(), body) != common.end()) ++n;
+    }
+    return n;
+  };
+  for (const RobotPair& rp : scene.self_pairs()) {
+    const std::vector<int> c1 = chain(m.geom_bodyid[rp.geom1]), c2 = chain(m.geom_bodyid[rp.geom2]);
+    std::vector<int> common;  // the deepest common body and its ancestors
+    for (int b : c2)
+      if (std::find(c1.begin(), c1.end(), b) != c1.end()) common.push_back(b);
+    SelfPair sp;
+    sp.link = link_of[static_cast<size_t>(rp.geom2)];
+    LEEWAY_DEMAND(sp.link >= 0);  // the later part moves with a joint: its geom is a link
+    sp.shared = shared_joints(links_[static_cast<size_t>(sp.link)], common);
+    sp.other_geom = rp.geom1;
+    sp.other_link = link_of[static_cast<size_t>(rp.geom1)];
+    if (sp.other_link >= 0) {
+      const Link& ol = links_[static_cast<size_t>(sp.other_link)];
+      sp.other_shared = shared_joints(ol, common);
+      if (sp.other_shared == static_cast<int>(ol.joints.size())) sp.other_link = -1;  // on the chain: still
+    }
+    self_pairs_.push_back(sp);
+  }
+  // Grouped by link and shared joints, so that a leaf builds each link's bound once per group.
+  std::stable_sort(self_pairs_.begin(), self_pairs_.end(), [](const SelfPair& a, const SelfPair& b) {
+    return std::tie(a.link, a.shared) < std::tie(b.link, b.shared);
+  });
+  obstacle_pairs_ = static_cast<int>(links_.size() * obstacles_.size());
+  all_pairs_.resize(static_cast<size_t>(obstacle_pairs_) + self_pairs_.size());
   for (size_t i = 0; i < all_pairs_.size(); ++i) all_pairs_[i] = static_cast<int>(i);
 }
 
@@ -139,7 +181,7 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
   ++stats.leaves;
   // Scratch kept across calls (capacity only): a leaf allocates nothing once the first has run.
   // One Certifier per thread and no recursion, so thread-local storage is enough.
-  thread_local Eigen::VectorXd c, h;
+  thread_local Eigen::VectorXd c, h, hl;
   c = (lower + upper) / 2;
   h = (upper - lower) / 2;
   state_.set(c);
@@ -149,7 +191,7 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
   const size_t nobs = obstacles_.size();
   thread_local std::vector<int> failing;
   failing.clear();
-  int last_link = -1;
+  int last_link = -1, last_shared = 0;
   if (failure) {
     failure->centre_hits = false;
     failure->gap = 0.0;
@@ -200,7 +242,7 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
         const int rq = l.joints[q];
         Term t;
         t.p = p;
-        t.coef = (p == q ? 0.5 : 1.0) * h[rp] * h[rq];
+        t.coef = (p == q ? 0.5 : 1.0) * hl[rp] * hl[rq];
         if (t.coef == 0) continue;
         const bool slide = prismatic_[static_cast<size_t>(rq)];
         const Eigen::Vector3d anchor = vec3(d.xanchor + 3 * scene_->joints()[static_cast<size_t>(rq)].id);
@@ -219,13 +261,41 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
     terms_ready = true;
   };
 
+  Obstacle other;       // a self pair's other robot geom, at c (grown by its own motion)
+  Box other_at_c;       // ... and as it is at c, for the centre test
   for (int pair : pairs) {
     ++stats.pair_tests;
-    const int li = pair / static_cast<int>(nobs);
+    // An obstacle pair (link, obstacle), or a self pair: the link against another robot geom. The
+    // distance between two robot geoms does not depend on the joints above their common ancestor
+    // (they move both rigidly), so those joints are held at c: the link's bound uses half-widths
+    // hl with them zeroed, and the other geom stands at its pose at c, grown by what the joints
+    // below the common ancestor can move it (a sound isotropic bound; zero on one chain, where
+    // the other geom is the ancestor's). docs/algorithm.md ("Self-collision") has the argument.
+    const bool self = pair >= obstacle_pairs_;
+    const SelfPair* pair_info = self ? &self_pairs_[static_cast<size_t>(pair - obstacle_pairs_)] : nullptr;
+    const int li = self ? pair_info->link : pair / static_cast<int>(nobs);
+    const int shared = self ? pair_info->shared : 0;
     const Link& link = links_[static_cast<size_t>(li)];
-    const Obstacle& obs = obstacles_[static_cast<size_t>(pair) % nobs];
-    if (li != last_link) {
+    if (self) {
+      other.geom = pair_info->other_geom;
+      other.box = other_at_c = geom_box(m, d, pair_info->other_geom);
+      double grow = 0;
+      if (pair_info->other_link >= 0) {
+        const Link& ol = links_[static_cast<size_t>(pair_info->other_link)];
+        for (size_t p = static_cast<size_t>(pair_info->other_shared); p < ol.joints.size(); ++p) {
+          const int r = ol.joints[p];
+          grow += h[r] * (prismatic_[static_cast<size_t>(r)] ? 1.0 : ol.lever[p] + ol.corner_lever);
+        }
+      }
+      other.box.half_size.array() += grow;
+      other.radius = other.box.half_size.norm();
+    }
+    const Obstacle& obs = self ? other : obstacles_[static_cast<size_t>(pair) % nobs];
+    if (li != last_link || shared != last_shared) {
       last_link = li;
+      last_shared = shared;
+      hl = h;
+      for (int p = 0; p < shared; ++p) hl[link.joints[static_cast<size_t>(p)]] = 0;
       box = geom_box(m, d, link.geom);
       link_ready = false;
       // The remainder's isotropic size, and a sphere around x(c) that holds the swept link without
@@ -239,12 +309,12 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
       for (size_t p = 0; p < n; ++p) {
         const int rp = link.joints[p];
         const bool slide_p = prismatic_[static_cast<size_t>(rp)];
-        iso_cheap += h[rp] * (slide_p ? 1.0 : link.lever[p]);
+        iso_cheap += hl[rp] * (slide_p ? 1.0 : link.lever[p]);
         if (slide_p) continue;
         for (size_t q = p; q < n; ++q) {
           const int rq = link.joints[q];
           const bool slide = prismatic_[static_cast<size_t>(rq)];
-          const double coef = (p == q ? 0.5 : 1.0) * h[rp] * h[rq];
+          const double coef = (p == q ? 0.5 : 1.0) * hl[rp] * hl[rq];
           r_pos[p] += coef * (slide ? 1.0 : link.lever[q]);
           if (!slide) r_rot[p] += coef;
         }
@@ -267,11 +337,11 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
         const Eigen::Vector3d a = vec3(d.xaxis + 3 * jid);
         if (prismatic_[static_cast<size_t>(r)]) {
           jac[p] = a;
-          lever_radius += h[r];
+          lever_radius += hl[r];
         } else {
           jac[p] = a.cross(box.center - vec3(d.xanchor + 3 * jid));
           for (int k = 0; k < 3; ++k) axis_jac[p].col(k) = a.cross(box.rotation.col(k));
-          lever_radius += h[r] * (link.lever[p] + link.corner_lever);
+          lever_radius += hl[r] * (link.lever[p] + link.corner_lever);
         }
       }
       // Lagrange remainder along the segment from c to q: 1/2 sum_pq h_p h_q sup |n . d2x/dq_p dq_q|.
@@ -290,7 +360,7 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
         const int rp = link.joints[p];
         axis[p] = vec3(d.xaxis + 3 * scene_->joints()[static_cast<size_t>(rp)].id);
         theta_before[p] = before;
-        if (!prismatic_[static_cast<size_t>(rp)]) before += h[rp];
+        if (!prismatic_[static_cast<size_t>(rp)]) before += hl[rp];
       }
       const double theta = before;
       // |v_q(q) - v_q(c)| per q.
@@ -298,10 +368,10 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
       for (size_t q = 0; q < n; ++q) {
         const int rq = link.joints[q];
         if (prismatic_[static_cast<size_t>(rq)]) continue;
-        dv[q] = (theta_before[q] + h[rq]) * link.lever[q];
+        dv[q] = (theta_before[q] + hl[rq]) * link.lever[q];
         for (size_t r = q + 1; r < n; ++r) {
           const int rr = link.joints[r];
-          dv[q] += h[rr] * (prismatic_[static_cast<size_t>(rr)] ? 1.0 : link.lever[r]);
+          dv[q] += hl[rr] * (prismatic_[static_cast<size_t>(rr)] ? 1.0 : link.lever[r]);
         }
       }
       // The remainder's terms are built only for pairs that the sphere test does not separate.
@@ -310,7 +380,7 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
       link_theta = theta;
       link_index = li;
       iso = rem_iso + box.half_size.norm();
-      for (size_t p = 0; p < n; ++p) iso += h[link.joints[p]] * jac[p].norm();
+      for (size_t p = 0; p < n; ++p) iso += hl[link.joints[p]] * jac[p].norm();
       // The first-order motion's directions, scaled by the half-widths: first(n, h) below is the
       // sum of |n . column|.
       // (It only grows: resizing to another size would allocate.)
@@ -318,7 +388,7 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
         motion.resize(3, static_cast<Eigen::Index>(4 * n));
       Eigen::Index col = 0;
       for (size_t p = 0; p < n; ++p) {
-        const double hp = h[link.joints[p]];
+        const double hp = hl[link.joints[p]];
         if (hp == 0) continue;
         motion.col(col++) = hp * jac[p];
         if (prismatic_[static_cast<size_t>(link.joints[p])]) continue;
@@ -427,7 +497,9 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
       // Blame: the joint whose motion moves this link most along the axis that came closest to
       // separating the pair (first order, plus its share of the remainder); it is the one to split
       // or shrink. Weights: the half-widths, or `blame` when given (a probe's offsets).
-      const Eigen::VectorXd& w = blame ? *blame : h;
+      thread_local Eigen::VectorXd w;
+      w = blame ? *blame : hl;
+      for (int p = 0; p < shared; ++p) w[link.joints[static_cast<size_t>(p)]] = 0;
       int best = -1;
       double best_contribution = 0;
       for (size_t p = 0; p < link.joints.size(); ++p) {
@@ -448,11 +520,13 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
       failure->upper = upper;
       failure->link_geom = link.geom;
       failure->obstacle_geom = obs.geom;
+      failure->self = self;
       failure->split_joint = best;
       failure->budget = false;
     }
     // Does the centre configuration itself come within the margin? Then no split can help.
-    if (failure && !failure->centre_hits) failure->centre_hits = touches(box, margin, obs.box, obs.plane);
+    if (failure && !failure->centre_hits)
+      failure->centre_hits = touches(box, margin, self ? other_at_c : obs.box, obs.plane);
     failing.push_back(pair);
   }
   pairs.swap(failing);

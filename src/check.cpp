@@ -121,6 +121,7 @@ CheckReport check_scene(const Scene& scene, const CheckOptions& options) {
     f.name = k.name;
     f.q = k.q;
     f.collisions = state.contacts(k.q);
+    f.self_collisions = state.self_contacts(k.q);
     f.tool = state.tool_pose();
     f.clearance = state.clearance(k.q);
     f.limit_violations = scene.joints_outside_limits(k.q);
@@ -128,6 +129,11 @@ CheckReport check_scene(const Scene& scene, const CheckOptions& options) {
       report.problems.push_back("keyframe '" + k.name + "': link '" + scene.geom_label(c.link_geom) +
                                 "' collides with obstacle '" + scene.geom_label(c.obstacle_geom) +
                                 "' (depth " + format_number(c.depth) + " m)");
+    for (const auto& c : f.self_collisions)
+      report.problems.push_back("keyframe '" + k.name + "': robot geoms '" + scene.geom_label(c.geom1) +
+                                "' and '" + scene.geom_label(c.geom2) + "' collide (self-collision, depth " +
+                                format_number(c.depth) + " m); exclude the pair if it is an artefact of the "
+                                "collision shapes (docs/mjcf-conventions.md)");
     for (int j : f.limit_violations) {
       const auto& joint = scene.joints()[static_cast<size_t>(j)];
       const char* unit = joint.prismatic ? " m" : " rad";
@@ -212,10 +218,17 @@ nlohmann::json to_json(const Scene& scene, const CheckReport& report) {
   for (int g : scene.link_geoms()) links.push_back(scene.geom_label(g));
   json base = json::array();
   for (int g : scene.base_geoms()) base.push_back(scene.geom_label(g));
+  json excluded = json::array();
+  for (const auto& e : scene.excluded_pairs())
+    excluded.push_back({{"a", scene.geom_label(e.geom1)},
+                        {"b", scene.geom_label(e.geom2)},
+                        {"by", e.by_body ? "body exclude" : "leeway_exclude"}});
   out["robot"] = {{"root_body", object_name(m, mjOBJ_BODY, scene.robot_root_body())},
                   {"joints", joints},
                   {"link_geoms", links},
                   {"base_geoms", base},
+                  {"self_pairs", scene.self_pairs().size()},
+                  {"excluded_pairs", excluded},
                   {"tool_site", object_name(m, mjOBJ_SITE, scene.tool_site())}};
   const std::vector<Box> boxes = obstacle_boxes(scene);
   json obstacles = json::array();
@@ -235,6 +248,9 @@ nlohmann::json to_json(const Scene& scene, const CheckReport& report) {
       col.push_back({{"link", scene.geom_label(c.link_geom)},
                      {"obstacle", scene.geom_label(c.obstacle_geom)},
                      {"depth", c.depth}});
+    json self = json::array();
+    for (const auto& c : k.self_collisions)
+      self.push_back({{"a", scene.geom_label(c.geom1)}, {"b", scene.geom_label(c.geom2)}, {"depth", c.depth}});
     json lim = json::array();
     for (int j : k.limit_violations) {
       const auto& joint = scene.joints()[static_cast<size_t>(j)];
@@ -250,6 +266,7 @@ nlohmann::json to_json(const Scene& scene, const CheckReport& report) {
                     {"q", vec(k.q)},
                     {"tool_position", v3(k.tool.position)},
                     {"collisions", col},
+                    {"self_collisions", self},
                     {"limit_violations", lim},
                     {"clearance", clear}});
   }
@@ -283,6 +300,8 @@ std::string to_text(const Scene& scene, const CheckReport& report) {
   for (size_t i = 0; i < scene.joints().size(); ++i) os << (i ? " " : "") << scene.joints()[i].name;
   os << "), " << scene.link_geoms().size() << " link geoms, " << scene.base_geoms().size()
      << " base geoms, tool site '" << object_name(m, mjOBJ_SITE, scene.tool_site()) << "'\n";
+  os << "self-collision: " << scene.self_pairs().size() << " robot geom pairs checked, "
+     << scene.excluded_pairs().size() << " excluded by the cell\n";
   // A crowded cell (thousands of obstacles) would print one line of thousands of names: the text
   // names the first ones, --json lists every one.
   constexpr size_t kListedObstacles = 20;
@@ -295,7 +314,7 @@ std::string to_text(const Scene& scene, const CheckReport& report) {
   os << ")\n";
   for (const auto& k : report.keyframes) {
     os << "keyframe " << k.name << ": tool at " << vec3(k.tool.position) << " m, ";
-    if (k.collisions.empty() && k.limit_violations.empty()) {
+    if (k.collisions.empty() && k.self_collisions.empty() && k.limit_violations.empty()) {
       os << "within limits, ";
       if (k.clearance.link_geom >= 0)
         os << "clearance " << format_number(k.clearance.distance) << " m ("
@@ -304,8 +323,8 @@ std::string to_text(const Scene& scene, const CheckReport& report) {
       else
         os << "no obstacles\n";
     } else
-      os << k.collisions.size() << " collision(s), " << k.limit_violations.size()
-         << " joint(s) outside limits\n";
+      os << k.collisions.size() << " collision(s), " << k.self_collisions.size() << " self-collision(s), "
+         << k.limit_violations.size() << " joint(s) outside limits\n";
   }
   for (const auto& g : report.goals) {
     os << "goal site " << g.site << " at " << vec3(g.position) << " m: goal obstacle "

@@ -31,9 +31,14 @@ double plane_distance(const mjData& d, int plane, int geom) {
 
 // mj_collideGeoms up to the narrowphase's contact count, without adding contacts.
 bool geoms_in_contact(const mjModel& m, const mjData& d, int g1, int g2) {
+  return !filtered(m, g1, g2) && geoms_touch(m, d, g1, g2);
+}
+
+// mj_collideGeoms after its filter: margin, bounding spheres, planes, then the narrowphase.
+bool geoms_touch(const mjModel& m, const mjData& d, int g1, int g2) {
   if (m.geom_type[g1] > m.geom_type[g2]) std::swap(g1, g2);
   const mjfCollision collide = mjCOLLISIONFUNC[m.geom_type[g1]][m.geom_type[g2]];
-  if (!collide || filtered(m, g1, g2)) return false;
+  if (!collide) return false;
   const mjtNum margin = std::max(m.geom_margin[g1], m.geom_margin[g2]);
   const mjtNum* x1 = d.geom_xpos + 3 * g1;
   const mjtNum* x2 = d.geom_xpos + 3 * g2;
@@ -59,9 +64,26 @@ CollisionChecker parse_checker(const std::string& name) {
 }
 
 bool emulates_mj_collision(const mjModel& m) {
-  return m.npair == 0 && m.nexclude == 0 && !(m.opt.enableflags & mjENBL_OVERRIDE) &&
+  return m.npair == 0 && !excludes_a_contact(m) && !(m.opt.enableflags & mjENBL_OVERRIDE) &&
          !(m.opt.disableflags & (mjDSBL_CONTACT | mjDSBL_CONSTRAINT)) && m.nconmax != 0 &&
          !mjcb_contactfilter;
+}
+
+std::pair<int, int> excluded_bodies(const mjModel& m, int i) {
+  // MuJoCo 2.2.2 stores ((body1 + 1) << 16) + body2 + 1, sorted, with body1 < body2.
+  const int sig = m.exclude_signature[i];
+  return {(sig >> 16) - 1, (sig & 0xFFFF) - 1};
+}
+
+bool excludes_a_contact(const mjModel& m) {
+  for (int i = 0; i < m.nexclude; ++i) {
+    const auto [b1, b2] = excluded_bodies(m, i);
+    for (int g1 = m.body_geomadr[b1]; g1 >= 0 && g1 < m.body_geomadr[b1] + m.body_geomnum[b1]; ++g1)
+      for (int g2 = m.body_geomadr[b2]; g2 >= 0 && g2 < m.body_geomadr[b2] + m.body_geomnum[b2]; ++g2)
+        if ((m.geom_contype[g1] & m.geom_conaffinity[g2]) || (m.geom_contype[g2] & m.geom_conaffinity[g1]))
+          return true;
+  }
+  return false;
 }
 
 Aabb geom_aabb(const mjModel& m, const mjData& d, int g) {

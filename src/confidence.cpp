@@ -71,13 +71,16 @@ CfResult confidence_factor(const Scene& scene, const std::vector<WaypointBounds>
                                         ? timing.segment_start[static_cast<size_t>(i)] / timing.total
                                         : static_cast<double>(i) / segments;
   std::vector<long> free_count(static_cast<size_t>(params.windows), 0);
+  std::vector<long> obstacle_count(static_cast<size_t>(params.windows), 0);
+  std::vector<long> self_count(static_cast<size_t>(params.windows), 0);
+  std::vector<long> any_count(static_cast<size_t>(params.windows), 0);
   detail::parallel_for(params.windows, threads, [&] {
     // One RobotState (one mjData) per thread.
     auto state = std::make_shared<RobotState>(scene);
     return [&, state](int w) {
       std::mt19937_64 rng(splitmix(params.seed ^ splitmix(static_cast<std::uint64_t>(w))));
       Eigen::VectorXd q(scene.dof());
-      long ok = 0;
+      long ok = 0, obstacle = 0, self = 0, any = 0;
       for (int k = 0; k < params.samples; ++k) {
         // A moment in window w (as a share of the path's duration), then its segment (the last
         // one starting at or before it: a segment of zero duration is never drawn) and the
@@ -92,9 +95,17 @@ CfResult confidence_factor(const Scene& scene, const std::vector<WaypointBounds>
         const WaypointBounds& a = bounds[static_cast<size_t>(seg)];
         const WaypointBounds& b = bounds[std::min(bounds.size() - 1, static_cast<size_t>(seg) + 1)];
         detail::draw_in_segment(a.lower, a.upper, b.lower, b.upper, t, rng, q);
-        ok += state->in_collision(q) ? 0 : 1;
+        const bool hit_obstacle = state->obstacle_contact(q);
+        const bool hit_self = state->self_contact() >= 0;
+        obstacle += hit_obstacle;
+        self += hit_self;
+        any += hit_obstacle || hit_self;
+        ok += hit_obstacle || (params.self && hit_self) ? 0 : 1;
       }
       free_count[static_cast<size_t>(w)] = ok;
+      obstacle_count[static_cast<size_t>(w)] = obstacle;
+      self_count[static_cast<size_t>(w)] = self;
+      any_count[static_cast<size_t>(w)] = any;
     };
   });
 
@@ -107,6 +118,9 @@ CfResult confidence_factor(const Scene& scene, const std::vector<WaypointBounds>
     const double share = static_cast<double>(free_count[static_cast<size_t>(w)]) / params.samples;
     r.window_cf.push_back(share);
     total_free += free_count[static_cast<size_t>(w)];
+    r.obstacle_collisions += obstacle_count[static_cast<size_t>(w)];
+    r.self_collisions += self_count[static_cast<size_t>(w)];
+    r.any_collisions += any_count[static_cast<size_t>(w)];
     if (share < r.worst_window_cf) {
       r.worst_window_cf = share;
       r.worst_window = w;

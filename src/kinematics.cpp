@@ -111,6 +111,41 @@ void RobotState::run_collision() {
 }
 
 bool RobotState::in_collision(const Eigen::VectorXd& q) {
+  return obstacle_contact(q) || self_contact() >= 0;
+}
+
+int RobotState::self_contact() const {
+  const mjModel& m = scene_->model();
+  const std::vector<RobotPair>& pairs = scene_->self_pairs();
+  for (size_t i = 0; i < pairs.size(); ++i)
+    if (geoms_touch(m, *data_, pairs[i].geom1, pairs[i].geom2)) return static_cast<int>(i);
+  return -1;
+}
+
+std::vector<SelfContact> RobotState::self_contacts(const Eigen::VectorXd& q) {
+  set(q);
+  const mjModel& m = scene_->model();
+  std::vector<SelfContact> out;
+  for (const RobotPair& p : scene_->self_pairs()) {
+    if (!geoms_touch(m, *data_, p.geom1, p.geom2)) continue;
+    SelfContact c{p.geom1, p.geom2, 0.0};
+    if (m.geom_type[p.geom1] == mjGEOM_BOX && m.geom_type[p.geom2] == mjGEOM_BOX) {
+      c.depth = std::max(0.0, box_penetration(geom_box(m, *data_, p.geom1), geom_box(m, *data_, p.geom2)));
+    } else {
+      int g1 = p.geom1, g2 = p.geom2;
+      if (m.geom_type[g1] > m.geom_type[g2]) std::swap(g1, g2);
+      mjContact con[mjMAXCONPAIR];
+      const int n = mjCOLLISIONFUNC[m.geom_type[g1]][m.geom_type[g2]](
+          &m, data_.get(), con, g1, g2, std::max(m.geom_margin[g1], m.geom_margin[g2]));
+      for (int k = 0; k < n; ++k) c.depth = std::max(c.depth, -static_cast<double>(con[k].dist));
+    }
+    out.push_back(c);
+  }
+  std::sort(out.begin(), out.end(), [](const SelfContact& a, const SelfContact& b) { return a.depth > b.depth; });
+  return out;
+}
+
+bool RobotState::obstacle_contact(const Eigen::VectorXd& q) {
   set(q);
   const mjModel& m = scene_->model();
   if (scene_->checker() == CollisionChecker::kMidphase)

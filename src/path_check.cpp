@@ -55,13 +55,22 @@ PathCheckResult check_path(const Scene& scene, const std::vector<Eigen::VectorXd
       c.joint = outside.front();
     } else {
       const auto contacts = state.contacts(q);
-      LEEWAY_DEMAND(!contacts.empty());
-      c.link_geom = contacts.front().link_geom;
-      c.obstacle_geom = contacts.front().obstacle_geom;
+      if (!contacts.empty()) {
+        c.link_geom = contacts.front().link_geom;
+        c.obstacle_geom = contacts.front().obstacle_geom;
+        c.depth = contacts.front().depth;
+        c.contacts = static_cast<int>(contacts.size());
+      } else {
+        const auto self = state.self_contacts(q);
+        LEEWAY_DEMAND(!self.empty());
+        c.self = true;
+        c.link_geom = self.front().geom2;
+        c.obstacle_geom = self.front().geom1;
+        c.depth = self.front().depth;
+        c.contacts = static_cast<int>(self.size());
+      }
       c.link = scene.geom_label(c.link_geom);
       c.obstacle = scene.geom_label(c.obstacle_geom);
-      c.depth = contacts.front().depth;
-      c.contacts = static_cast<int>(contacts.size());
     }
     result.collision = std::move(c);
     return false;
@@ -98,6 +107,11 @@ std::string describe_collision(const Scene& scene, const PathCollision& c, bool 
     return "leaves the limits of joint '" + j.name + "' (" + format_number(c.q[c.joint]) + unit +
            ", limits [" + format_number(j.lower) + ", " + format_number(j.upper) + "]" + unit + ") " + where;
   }
+  if (c.self)
+    return "hits itself " + where + ": robot geoms '" + c.obstacle + "' and '" + c.link + "' (depth " +
+           format_number(c.depth) + " m" +
+           (c.contacts > 1 ? ", and " + std::to_string(c.contacts - 1) + " more self pairs" : std::string()) +
+           ")";
   return "hits '" + c.obstacle + "' " + where + " (link '" + c.link + "', depth " + format_number(c.depth) +
          " m" +
          (c.contacts > 1 ? ", and " + std::to_string(c.contacts - 1) + " more contacts" : std::string()) +

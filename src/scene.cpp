@@ -196,6 +196,8 @@ void Scene::recognise(const SceneOptions& options) {
                      ": the robot has no collidable geoms on its moving bodies "
                      "(contype or conaffinity must be non-zero)");
 
+  find_self_pairs();
+
   // Sites: the tool site in the robot, goal sites outside it.
   // A model the midphase cannot answer for (explicit pairs, excludes, ...) is checked by MuJoCo's
   // full pass: decided once here, not on every check.
@@ -272,6 +274,83 @@ void Scene::recognise(const SceneOptions& options) {
   for (int g = 0; g < m.ngeom; ++g)
     if (roles_[static_cast<size_t>(g)] != GeomRole::kLink) statics.push_back(g);
   statics_.build(m, *d, statics);
+}
+
+void Scene::find_self_pairs() {
+  const mjModel& m = *model_;
+  const std::string& file = source_;
+  auto robot_body = [&](int b) { return b > 0 && top_ancestor(m, b) == robot_root_; };
+  auto body_label = [&](int b) {
+    const std::string n = object_name(m, mjOBJ_BODY, b);
+    return n.empty() ? (b == 0 ? std::string("world") : "#" + std::to_string(b)) : n;
+  };
+  // MuJoCo's body excludes: between robot bodies they drop self pairs; between the robot and the
+  // cell they would drop obstacle contacts, which leeway refuses (a bound must never ignore the cell).
+  std::vector<std::pair<int, int>> body_excludes;
+  for (int i = 0; i < m.nexclude; ++i) {
+    const auto [b1, b2] = excluded_bodies(m, i);
+    if (robot_body(b1) != robot_body(b2))
+      throw InputError(file + ": <exclude body1='" + body_label(b1) + "' body2='" + body_label(b2) +
+                       "'> pairs a robot body with a body of the cell; leeway excludes only robot-robot "
+                       "pairs (docs/mjcf-conventions.md)");
+    if (robot_body(b1)) body_excludes.emplace_back(b1, b2);
+  }
+  auto body_excluded = [&](int b1, int b2) {
+    for (const auto& [x, y] : body_excludes)
+      if ((x == b1 && y == b2) || (x == b2 && y == b1)) return true;
+    return false;
+  };
+  // Geom excludes: custom texts named leeway_exclude* whose data names two robot geoms.
+  std::vector<std::pair<int, int>> geom_excludes;
+  for (int t = 0; t < m.ntext; ++t) {
+    const std::string name = object_name(m, mjOBJ_TEXT, t);
+    if (name.rfind("leeway_exclude", 0) != 0) continue;
+    std::istringstream words(std::string(m.text_data + m.text_adr[t], static_cast<size_t>(std::max(0, m.text_size[t] - 1))));
+    std::vector<std::string> geoms;
+    for (std::string w; words >> w;) geoms.push_back(w);
+    if (geoms.size() != 2)
+      throw InputError(file + ": custom text '" + name + "' must name two robot geoms, not " +
+                       std::to_string(geoms.size()) + " words");
+    int ids[2];
+    for (int k = 0; k < 2; ++k) {
+      ids[k] = mj_name2id(&m, mjOBJ_GEOM, geoms[static_cast<size_t>(k)].c_str());
+      if (ids[k] < 0)
+        throw InputError(file + ": custom text '" + name + "' names geom '" + geoms[static_cast<size_t>(k)] +
+                         "', which does not exist");
+      const GeomRole r = roles_[static_cast<size_t>(ids[k])];
+      if (r != GeomRole::kLink && r != GeomRole::kRobotBase)
+        throw InputError(file + ": custom text '" + name + "' names geom '" + geoms[static_cast<size_t>(k)] +
+                         "', which is not a collidable robot geom");
+    }
+    geom_excludes.emplace_back(ids[0], ids[1]);
+  }
+  auto geom_excluded = [&](int g1, int g2) {
+    for (const auto& [x, y] : geom_excludes)
+      if ((x == g1 && y == g2) || (x == g2 && y == g1)) return true;
+    return false;
+  };
+
+  std::vector<int> robot;
+  for (int g = 0; g < m.ngeom; ++g)
+    if (roles_[static_cast<size_t>(g)] == GeomRole::kLink || roles_[static_cast<size_t>(g)] == GeomRole::kRobotBase)
+      robot.push_back(g);
+  auto part = [&](int g) { return m.body_weldid[m.geom_bodyid[g]]; };
+  auto parent_part = [&](int w) { return w == 0 ? -1 : m.body_weldid[m.body_parentid[w]]; };
+  for (size_t i = 0; i < robot.size(); ++i)
+    for (size_t j = i + 1; j < robot.size(); ++j) {
+      int g1 = robot[i], g2 = robot[j];
+      int w1 = part(g1), w2 = part(g2);
+      if (w1 == w2 || parent_part(w1) == w2 || parent_part(w2) == w1) continue;  // rigid or jointed together
+      if (w1 > w2) {
+        std::swap(g1, g2);
+        std::swap(w1, w2);
+      }
+      const bool by_body = body_excluded(m.geom_bodyid[g1], m.geom_bodyid[g2]);
+      if (by_body || geom_excluded(g1, g2))
+        excluded_pairs_.push_back({g1, g2, by_body});
+      else
+        self_pairs_.push_back({g1, g2});
+    }
 }
 
 std::vector<std::string> Scene::joint_names() const {

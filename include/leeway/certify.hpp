@@ -2,7 +2,7 @@
 //! @file certify.hpp
 //! Certified free regions of joint space: a conservative test that every configuration in a box
 //! of joint values (or in the interpolated bounds between two waypoints) keeps every robot link
-//! clear of every real obstacle. Not a sample: a proof by bounds. docs/algorithm.md ("Certified
+//! clear of every real obstacle and of the robot's other geoms (Scene::self_pairs()). Not a sample: a proof by bounds. docs/algorithm.md ("Certified
 //! intervals") derives the bounds and the argument that makes each conservative.
 
 #include <Eigen/Core>
@@ -45,7 +45,8 @@ struct CertifyStats {
 struct CertifyFailure {
   Eigen::VectorXd lower, upper;  //!< the leaf [rad or m]
   int link_geom = -1;            //!< the pair that could not be separated
-  int obstacle_geom = -1;
+  int obstacle_geom = -1;        //!< an obstacle, or the other robot geom when `self`
+  bool self = false;             //!< the pair is two robot geoms (self-collision)
   int split_joint = -1;  //!< the joint whose motion contributes most to the failing pair
   bool budget = false;   //!< the leaf budget or depth ran out (rather than a leaf of width 0)
   //! The leaf's centre configuration itself comes within the margin of the obstacle: no
@@ -56,7 +57,7 @@ struct CertifyFailure {
   double gap = 0.0;
 };
 
-//! Proves joint-space regions free against the scene's obstacles. One object per thread (it owns
+//! Proves joint-space regions free against the scene's obstacles and the robot itself. One object per thread (it owns
 //! one mjData); the Scene must outlive it.
 class Certifier {
  public:
@@ -96,6 +97,10 @@ class Certifier {
   bool leaf_free(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, CertifyStats& stats,
                  CertifyFailure* failure = nullptr);
 
+  //! How many pairs each leaf proves: (link, obstacle) pairs and robot self pairs.
+  int obstacle_pair_count() const { return obstacle_pairs_; }
+  int self_pair_count() const { return static_cast<int>(self_pairs_.size()); }
+
   const CertifyOptions& options() const { return options_; }
   void set_options(const CertifyOptions& o) { options_ = o; }
   const Scene& scene() const { return *scene_; }
@@ -106,6 +111,16 @@ class Certifier {
     std::vector<int> joints;    //!< robot joint indices that move this geom, base to tip
     std::vector<double> lever;  //!< per entry of `joints`: bound of |x - o_j| over all configurations [m]
     double corner_lever = 0.0;  //!< per joint bound of |corner - o_j| (the loose reference) [m]
+  };
+  //! A self pair: link `link` moves against robot geom `other_geom`. The link's first `shared`
+  //! joints (those at or above the two geoms' deepest common body) are held at the leaf's centre;
+  //! other_link (-1 when it does not move against the link's chain) likewise with other_shared.
+  struct SelfPair {
+    int link = -1;
+    int shared = 0;
+    int other_geom = -1;
+    int other_link = -1;
+    int other_shared = 0;
   };
   struct Obstacle {
     int geom = -1;
@@ -130,7 +145,9 @@ class Certifier {
   std::vector<Link> links_;
   std::vector<Obstacle> obstacles_;
   std::vector<bool> prismatic_;
-  std::vector<int> all_pairs_;  //!< every (link, obstacle) pair index, link-major
+  std::vector<SelfPair> self_pairs_;
+  int obstacle_pairs_ = 0;      //!< pair indices below it are (link, obstacle), link-major; the rest self pairs
+  std::vector<int> all_pairs_;  //!< every pair index
 };
 
 }  // namespace leeway

@@ -28,6 +28,7 @@ struct KeyframeFindings {
   Eigen::VectorXd q;
   Pose tool;
   std::vector<Contact> collisions;
+  std::vector<SelfContact> self_collisions;  //!< robot geoms touching each other
   std::vector<int> limit_violations;  //!< joint indices
   Clearance clearance;                //!< closest link-obstacle pair
 };

@@ -10,6 +10,7 @@
 #include <mujoco/mujoco.h>
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "leeway/box.hpp"
@@ -28,10 +29,18 @@ const char* checker_name(CollisionChecker c);
 //! Parses checker_name()'s names. @throws InputError naming the value and the choices.
 CollisionChecker parse_checker(const std::string& name);
 
-//! True when any_contact() gives mj_collision's answer on this model: no explicit <pair> or
-//! <exclude>, no contact override, contacts and constraints enabled, no contact-filter callback.
-//! Otherwise the checkers fall back to mj_collision.
+//! True when any_contact() gives mj_collision's answer on this model: no explicit <pair>, no
+//! <exclude> that removes a contact the bitmasks allow (excludes_a_contact()), no contact override,
+//! contacts and constraints enabled, no contact-filter callback. Otherwise the checkers fall back to
+//! mj_collision.
 bool emulates_mj_collision(const mjModel& m);
+
+//! The two bodies of the model's i-th <contact><exclude> (MuJoCo keeps them sorted by id).
+std::pair<int, int> excluded_bodies(const mjModel& m, int i);
+
+//! True when some <exclude> pairs two bodies with geoms whose contype/conaffinity would let them
+//! touch: only then does the exclude change what mj_collision reports.
+bool excludes_a_contact(const mjModel& m);
 
 //! The static side of a contact query: geoms placed once, with their world AABBs indexed.
 struct StaticGeoms {
@@ -52,6 +61,11 @@ Aabb geom_aabb(const mjModel& m, const mjData& d, int geom);
 //! d: mj_collideGeoms's filter, margin, bounding-sphere and plane tests, then its narrowphase
 //! function's contact count (no contact is added to d).
 bool geoms_in_contact(const mjModel& m, const mjData& d, int g1, int g2);
+
+//! geoms_in_contact() without mj_collideGeoms's filter (bitmasks, same weld body, parent): the
+//! margin, bounding-sphere and plane tests and MuJoCo's narrowphase function. For pairs whose
+//! filtering is leeway's own, such as the robot's self-collision pairs (Scene::self_pairs()).
+bool geoms_touch(const mjModel& m, const mjData& d, int g1, int g2);
 
 //! True when mj_collision on (m, d) would report a contact between one of the `moving` geoms and
 //! one of `fixed`: for each moving geom, the static geoms whose AABB meets its AABB widened by the

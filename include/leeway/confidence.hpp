@@ -21,7 +21,10 @@ struct CfResult {
   double worst_window_cf = 0;
   std::vector<double> window_cf;  //!< per window
   long samples = 0;               //!< configurations tested
-  long collisions = 0;            //!< of which in collision
+  long collisions = 0;            //!< of which in collision (CfParams::self says what counts)
+  long obstacle_collisions = 0;   //!< samples where a link touches an obstacle
+  long self_collisions = 0;       //!< samples where two robot geoms touch (Scene::self_pairs())
+  long any_collisions = 0;        //!< samples with either
   bool timed = false;             //!< windows cut the path by time (every joint has a nominal speed)
   double duration = 0;            //!< the path's duration [s] when timed, else its segment count
 };

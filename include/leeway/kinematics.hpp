@@ -27,6 +27,13 @@ struct Contact {
   double depth = 0.0;
 };
 
+//! Two robot geoms in contact (a Scene::self_pairs() pair).
+struct SelfContact {
+  int geom1 = -1;  //!< on the part nearer the robot's root (RobotPair::geom1)
+  int geom2 = -1;
+  double depth = 0.0;  //!< penetration depth [m] (>= 0), as Contact::depth
+};
+
 //! The smallest distance between the robot's links and the obstacles.
 struct Clearance {
   double distance = INFINITY;  //!< [m]; 0 in contact
@@ -59,12 +66,20 @@ class RobotState {
     set(q);
     return tool_pose();
   }
+  //! True when the robot touches an obstacle or itself at q: obstacle_contact(q), or a self pair
+  //! in contact (self_contact()). What every check of a configuration uses.
+  bool in_collision(const Eigen::VectorXd& q);
   //! True when a robot link touches or penetrates an obstacle at q: mj_collision's answer, from the
   //! scene's checker (Scene::checker(): the midphase adds no contacts to data(); use contacts()
-  //! for them).
-  bool in_collision(const Eigen::VectorXd& q);
+  //! for them). Self-collision is not looked at.
+  bool obstacle_contact(const Eigen::VectorXd& q);
+  //! The index in Scene::self_pairs() of the first pair in contact at the configuration last passed
+  //! to set(), or -1: MuJoCo's narrowphase on each pair (geoms_touch(), the geoms' margins included).
+  int self_contact() const;
   //! All robot-link-versus-obstacle contacts at q (deepest first).
   std::vector<Contact> contacts(const Eigen::VectorXd& q);
+  //! All self pairs in contact at q (deepest first).
+  std::vector<SelfContact> self_contacts(const Eigen::VectorXd& q);
   //! Clearance between robot links and obstacles at q: exact box-to-box distances (non-box geoms
   //! by their bounding boxes, so a lower bound for them; planes are skipped).
   Clearance clearance(const Eigen::VectorXd& q);

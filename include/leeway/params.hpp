@@ -88,6 +88,9 @@ struct CfParams {
   int windows = 30;        //!< the path is split into this many windows
   int samples = 10000;     //!< random configurations per window
   std::uint64_t seed = 1;  //!< RNG seed
+  //! A sample counts as colliding when it hits an obstacle (the thesis's CF, false) or also when
+  //! the robot hits itself (true). Both counts are reported either way.
+  bool self = false;
 };
 
 //! How the bounds are made safe against the real obstacles after the volume-guided bisection.

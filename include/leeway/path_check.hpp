@@ -45,7 +45,10 @@ struct PathCollision {
   std::string link;      //!< Scene::geom_label(link_geom), or "" (limits)
   std::string obstacle;  //!< Scene::geom_label(obstacle_geom), or "" (limits)
   double depth = 0.0;    //!< penetration depth of the deepest contact [m] (RobotState::contacts)
-  int contacts = 0;      //!< link-obstacle pairs in contact at q
+  int contacts = 0;      //!< link-obstacle pairs in contact at q (self pairs when `self`)
+  //! The robot hits itself at q: link_geom and obstacle_geom are then two robot geoms (a
+  //! Scene::self_pairs() pair, geom1 as obstacle_geom), and no obstacle is touched.
+  bool self = false;
   //! A joint outside its limits at q (then there is no contact data), else -1.
   int joint = -1;
 };

@@ -26,8 +26,26 @@ struct RobotJoint {
 enum class GeomRole {
   kIgnored,    //!< not collidable in the file (contype = conaffinity = 0): visual only
   kLink,       //!< collidable geom on a robot body that moves with a joint
-  kRobotBase,  //!< collidable geom on a robot body fixed to the world (base, rail): not checked
+  kRobotBase,  //!< collidable geom on a robot body fixed to the world (base, rail): only against links
   kObstacle,   //!< any other collidable geom
+};
+
+//! Two robot geoms that leeway checks against each other (self-collision): on rigid parts of the
+//! robot (MuJoCo's weld bodies) that are neither the same nor parent and child, and not excluded
+//! by the cell. geom1 is on the part with the smaller body id (MuJoCo numbers parents first, so on
+//! one chain it is the part nearer the root).
+struct RobotPair {
+  int geom1 = -1;
+  int geom2 = -1;
+};
+
+//! A pair that would be a RobotPair but the cell excludes it.
+struct ExcludedPair {
+  int geom1 = -1;
+  int geom2 = -1;
+  //! true: MuJoCo's <contact><exclude body1 body2/>; false: a leeway_exclude custom text naming
+  //! the two geoms (docs/mjcf-conventions.md).
+  bool by_body = false;
 };
 
 //! A named keyframe's joint values (robot joints in order).
@@ -46,7 +64,7 @@ struct SceneOptions {
 
 //! A loaded, recognised workcell. Owns its mjModel, whose collision bitmasks are normalised so that
 //! MuJoCo reports only robot-link-versus-obstacle contacts (bit 0 of link contype against bit 0 of
-//! obstacle conaffinity).
+//! obstacle conaffinity); the robot's pairs with itself are leeway's own list (self_pairs()).
 class Scene {
  public:
   //! Loads and recognises an MJCF file.
@@ -74,6 +92,9 @@ class Scene {
   const std::vector<int>& link_geoms() const { return link_geoms_; }
   const std::vector<int>& base_geoms() const { return base_geoms_; }
   const std::vector<int>& obstacle_geoms() const { return obstacle_geoms_; }
+  //! The robot geom pairs checked for self-collision (RobotPair), and those the cell excludes.
+  const std::vector<RobotPair>& self_pairs() const { return self_pairs_; }
+  const std::vector<ExcludedPair>& excluded_pairs() const { return excluded_pairs_; }
   GeomRole role(int geom) const { return roles_.at(static_cast<size_t>(geom)); }
   //! The geom's name, or "unnamed geom #id on body 'b'" when it has none.
   std::string geom_label(int geom) const;
@@ -105,6 +126,7 @@ class Scene {
  private:
   Scene() = default;
   void recognise(const SceneOptions& options);
+  void find_self_pairs();
 
   std::string source_;
   ModelPtr model_;
@@ -113,6 +135,8 @@ class Scene {
   std::vector<int> moving_bodies_, moving_geoms_, moving_sites_;
   std::vector<GeomRole> roles_;
   std::vector<int> link_geoms_, base_geoms_, obstacle_geoms_;
+  std::vector<RobotPair> self_pairs_;
+  std::vector<ExcludedPair> excluded_pairs_;
   int tool_site_ = -1;
   CollisionChecker checker_ = CollisionChecker::kMidphase;
   StaticGeoms statics_;

@@ -193,6 +193,7 @@ int run_bounds(const BoundsArgs& args) {
         {"waypoints", path.size()},
         {"obstacle", hit.obstacle_geom >= 0 ? json(hit.obstacle) : json(nullptr)},
         {"link", hit.link_geom >= 0 ? json(hit.link) : json(nullptr)},
+        {"self", hit.self},
         {"s", hit.path_fraction},
         {"depth", hit.depth},
         {"q", to_array(hit.q)},

@@ -20,6 +20,9 @@ CLI::App* add_cf(CLI::App& app, CfArgs& args) {
       ->check(seed_check_for(args.params.seed))
       ->capture_default_str();
   sub->add_option("--threads", args.threads, "Worker threads")->capture_default_str();
+  sub->add_flag("--self", args.params.self,
+                "Count self-collisions (robot geoms touching each other) as collisions too; both counts "
+                "are printed either way");
   sub->add_flag("--json", args.json, "Print JSON");
   return sub;
 }
@@ -38,6 +41,10 @@ int run_cf(const CfArgs& args) {
                           {"window_cf", r.window_cf},
                           {"samples", r.samples},
                           {"collisions", r.collisions},
+                          {"counts", args.params.self ? "obstacle and self collisions" : "obstacle collisions"},
+                          {"obstacle_collisions", r.obstacle_collisions},
+                          {"self_collisions", r.self_collisions},
+                          {"any_collisions", r.any_collisions},
                           {"windows", args.params.windows},
                           {"windows_by", r.timed ? "time" : "path parameter"},
                           {"duration", r.duration},
@@ -51,6 +58,9 @@ int run_cf(const CfArgs& args) {
               << " .. " << 100 * r.ci_high << " %), " << r.collisions << " of " << r.samples
               << " samples collide; worst window " << r.worst_window << " of " << args.params.windows << ": "
               << 100 * r.worst_window_cf << " %\n";
+    std::cout << "collisions: " << r.obstacle_collisions << " with obstacles, " << r.self_collisions
+              << " self-collisions, " << r.any_collisions << " samples with either"
+              << (args.params.self ? " (CF counts both: --self)\n" : " (CF counts obstacles only; --self counts both)\n");
     if (r.timed)
       std::cout << std::setprecision(3) << "windows: " << args.params.windows << " of equal duration, "
                 << r.duration / args.params.windows

@@ -136,7 +136,8 @@ void check_fields(const Fields& f, const json& s, bool is_defaults) {
   f.one_of("safety", {"certified", "sampled", "none"});
   f.one_of("checker", {"midphase", "mujoco"});
   if (s.contains("cf")) {
-    f.known_keys(s["cf"], "cf", {"windows", "samples", "seed"});
+    f.known_keys(s["cf"], "cf", {"windows", "samples", "seed", "self"});
+    f.flag("cf.self");
     f.whole("cf.windows", 1, 1000000);
     f.whole("cf.samples", 1, 100000000);
     f.whole("cf.seed", 0, std::numeric_limits<long long>::max());
@@ -147,7 +148,9 @@ void check_fields(const Fields& f, const json& s, bool is_defaults) {
     f.number("plan.time_limit", 1e-3, 3600, "a time from 0.001 to 3600 s");
   }
   if (s.contains("expect")) {
-    f.known_keys(s["expect"], "expect", {"check", "cf_min", "certified", "mean_width_min", "time_max"});
+    f.known_keys(s["expect"], "expect",
+                 {"check", "cf_min", "certified", "mean_width_min", "self_collisions_max", "time_max"});
+    f.whole("expect.self_collisions_max", 0, std::numeric_limits<long long>::max());
     f.flag("expect.check");
     f.number("expect.cf_min", 0, 1, "a fraction from 0 to 1");
     f.flag("expect.certified");
@@ -178,6 +181,7 @@ Params scenario_params(const Scene& scene, const json& s) {
     p.cf.windows = s["cf"].value("windows", p.cf.windows);
     p.cf.samples = s["cf"].value("samples", p.cf.samples);
     p.cf.seed = s["cf"].value("seed", p.cf.seed);
+    p.cf.self = s["cf"].value("self", p.cf.self);
   }
   p.validate();
   return p;
@@ -314,6 +318,8 @@ Suite read_suite(const std::string& file) {
     sc.expect.cf_min = f.number("expect.cf_min", 0, 1, "");
     sc.expect.certified = f.flag("expect.certified");
     sc.expect.mean_width_min = f.number("expect.mean_width_min", 0, 1e3, "");
+    if (s.contains("expect") && s["expect"].contains("self_collisions_max"))
+      sc.expect.self_collisions_max = s["expect"]["self_collisions_max"].get<long>();
     sc.expect.time_max = f.number("expect.time_max", 0, 1e6, "");
     suite.scenarios.push_back(std::move(sc));
   }
@@ -413,6 +419,8 @@ json run_scenario(const json& resolved, int threads) {
     measured["cf_ci_high"] = cf.ci_high;
     measured["cf_samples"] = cf.samples;
     measured["cf_collisions"] = cf.collisions;
+    measured["cf_obstacle_collisions"] = cf.obstacle_collisions;
+    measured["cf_self_collisions"] = cf.self_collisions;
     measured["mean_width"] = widths.mean_width;
     measured["bisected"] = widths.bisected;
     measured["collapsed"] = widths.collapsed;
@@ -438,28 +446,33 @@ void judge(const Scenario& scenario, json& result) {
   const json measured = result.value("measured", json::object());
   json list = json::array();
   bool all = ok;
+  // cmp: +1 measured >= expected, 0 equal, -1 measured <= expected.
   const auto add = [&](const char* name, const std::string& title, const json& expected, const char* key,
-                       bool at_least) {
+                       int cmp) {
     json e = {{"name", name}, {"title", title}, {"expected", expected}};
     if (!ok || !measured.contains(key)) {
       e["measured"] = nullptr;
       e["passed"] = false;
     } else {
       e["measured"] = measured[key];
-      e["passed"] =
-          at_least ? measured[key].get<double>() >= expected.get<double>() : measured[key] == expected;
+      const bool passed = cmp > 0   ? measured[key].get<double>() >= expected.get<double>()
+                          : cmp < 0 ? measured[key].get<double>() <= expected.get<double>()
+                                    : measured[key] == expected;
+      e["passed"] = passed;
     }
     all = all && e["passed"].get<bool>();
     list.push_back(e);
   };
   const Expectations& x = scenario.expect;
-  if (x.check) add("check", *x.check ? "check passes" : "check fails", *x.check, "check_passed", false);
-  if (x.cf_min) add("cf_min", "CF >= " + format_number(*x.cf_min), *x.cf_min, "cf", true);
-  if (x.certified)
-    add("certified", *x.certified ? "certified" : "not certified", *x.certified, "certified", false);
+  if (x.check) add("check", *x.check ? "check passes" : "check fails", *x.check, "check_passed", 0);
+  if (x.cf_min) add("cf_min", "CF >= " + format_number(*x.cf_min), *x.cf_min, "cf", 1);
+  if (x.certified) add("certified", *x.certified ? "certified" : "not certified", *x.certified, "certified", 0);
   if (x.mean_width_min)
     add("mean_width_min", "mean width >= " + format_number(*x.mean_width_min) + " rad", *x.mean_width_min,
-        "mean_width", true);
+        "mean_width", 1);
+  if (x.self_collisions_max)
+    add("self_collisions_max", "CF samples in self-collision <= " + std::to_string(*x.self_collisions_max),
+        *x.self_collisions_max, "cf_self_collisions", -1);
   result["expectations"] = list;
   result["passed"] = all;
   if (x.time_max) {

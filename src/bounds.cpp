@@ -224,8 +224,11 @@ std::vector<WaypointBounds> bound_path(const VolumeModel& world, const std::vect
   // One VolumeChecker (one mjData) per thread, made once.
   std::vector<std::unique_ptr<VolumeChecker>> checkers;
   for (int t = 0; t < threads; ++t) checkers.push_back(std::make_unique<VolumeChecker>(world));
-  auto collides_with = [](VolumeChecker& c) {
-    return CollisionFn([&c](const Eigen::VectorXd& q) { return c.in_collision(q); });
+  // A probe collides when the robot touches the volume, or (bounds.self_collision) itself.
+  auto collides_with = [&params](VolumeChecker& c) {
+    return CollisionFn([&c, self = params.self_collision](const Eigen::VectorXd& q) {
+      return c.in_collision(q) || (self && c.touches_itself());
+    });
   };
   if (waypoints >= threads) {
     // Enough waypoints for every thread: one waypoint per task, its runs in order.

@@ -7,7 +7,7 @@
 
 namespace leeway {
 
-nlohmann::json safety_json(const SafetyReport& report, const SafetyParams& params) {
+nlohmann::json safety_json(const Scene& scene, const SafetyReport& report, const SafetyParams& params) {
   using nlohmann::json;
   json segments = json::array();
   for (const auto& s : report.segments) {
@@ -28,6 +28,16 @@ nlohmann::json safety_json(const SafetyReport& report, const SafetyParams& param
     out["max_leaves"] = params.max_leaves;
     out["leaves"] = report.stats.leaves;
     out["max_depth"] = report.stats.max_depth;
+    // What the certificate proved apart: every link against every obstacle, and the robot's own
+    // pairs (Scene::self_pairs()); the pairs the cell excludes are listed, never proven.
+    json excluded = json::array();
+    for (const auto& e : scene.excluded_pairs())
+      excluded.push_back({{"a", scene.geom_label(e.geom1)},
+                          {"b", scene.geom_label(e.geom2)},
+                          {"by", e.by_body ? "body exclude" : "leeway_exclude"}});
+    out["pairs"] = {{"link_obstacle", scene.link_geoms().size() * scene.obstacle_geoms().size()},
+                    {"self", scene.self_pairs().size()},
+                    {"excluded", excluded}};
   } else if (report.mode == SafetyMode::kSampled) {
     out["passed"] = report.all_passed;
     out["epsilon"] = params.epsilon;
@@ -86,7 +96,7 @@ nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Param
       run.categories.goal_geom >= 0 ? json(scene.geom_label(run.categories.goal_geom)) : json(nullptr);
   out["trail_boxes"] = run.categories.trail.size();
   out["collision_checks"] = run.checks;
-  out["safety"] = safety_json(run.safety, params.safety);
+  out["safety"] = safety_json(scene, run.safety, params.safety);
   out["timing_ms"] = {{"categorize", run.ms_categorize}, {"volume", run.ms_volume},
                       {"inject", run.ms_inject},         {"bounds", run.ms_bounds},
                       {"safety", run.ms_safety},         {"total", run.ms_total()}};

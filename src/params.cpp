@@ -48,6 +48,7 @@ void for_each_field(P& p, F&& f) {
   f("bounds", "min_half_width", p.bounds.min_half_width);
   f("bounds", "wrist_half_width", p.bounds.wrist_half_width);
   f("bounds", "linear_axis_tolerance", p.bounds.linear_axis_tolerance);
+  f("bounds", "self_collision", p.bounds.self_collision);
   f("cf", "windows", p.cf.windows);
   f("cf", "samples", p.cf.samples);
   f("cf", "seed", p.cf.seed);
@@ -251,6 +252,7 @@ Params preset_params(const std::string& name) {
     p.volume.alpha_g = 3.9620660871306113;
     p.volume.alpha_ng = 3.568484783491677;
     p.volume.trail_margin = 0.05451587373395741;
+    p.bounds.self_collision = true;
     p.safety.mode = SafetyMode::kCertified;
     return p;
   }

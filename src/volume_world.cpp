@@ -392,8 +392,6 @@ bool VolumeChecker::in_collision(const Eigen::VectorXd& q) {
     std::memcpy(d.geom_xmat + 9 * to, s.geom_xmat + 9 * from, 9 * sizeof(mjtNum));
   }
   ++checks_;
-  // A probe where the robot touches itself is in collision too.
-  if (robot_.self_contact() >= 0) return true;
   if (checker_ == CollisionChecker::kMidphase) return midphase_collision();
   prevent_contact_warnings(d);  // a full contact buffer still answers "in collision"
   mj_collision(&world_->model(), &d);

@@ -40,12 +40,17 @@ std::string vec_str(const Eigen::VectorXd& v) {
 }
 
 // The clearance at q by the exact queries: RobotState::clearance for every pair but the planes, which
-// it skips, and for each plane obstacle the signed distance of every link box from its half-space
-// (normal = the plane's z axis, surface through its centre). 0 in contact.
+// it skips, for each plane obstacle the signed distance of every link box from its half-space
+// (normal = the plane's z axis, surface through its centre), and the exact box distance of every
+// self pair (Scene::self_pairs(); then obstacle_geom is the pair's other robot geom). 0 in contact.
 Clearance exact_clearance(RobotState& state, const Eigen::VectorXd& q) {
   Clearance best = state.clearance(q);  // runs the kinematics at q
   const Scene& scene = state.scene();
   const mjModel& m = scene.model();
+  for (const RobotPair& p : scene.self_pairs()) {
+    const double dist = box_distance(geom_box(m, state.data(), p.geom2), geom_box(m, state.data(), p.geom1));
+    if (dist < best.distance) best = {dist, p.geom2, p.geom1};
+  }
   for (int o : scene.obstacle_geoms()) {
     if (m.geom_type[o] != mjGEOM_PLANE) continue;
     const Box plane = geom_box(m, state.data(), o);
@@ -250,7 +255,52 @@ const char* kTelescopeCell = R"(<mujoco model="telescope">
 </mujoco>
 )";
 
+// A planar arm that folds onto itself, on a fixed post, with a hand and two sliding fingers (a
+// branch: both fingers move against their common parent) and a table in the arm's plane. Self pairs:
+// post against the knuckle, forearm, palm and fingers; upper arm against forearm, palm and fingers;
+// knuckle against palm and fingers; the two fingers (which overlap when both close past 2 cm).
+const char* kFoldingHandCell = R"(<mujoco model="folding_hand">
+  <compiler angle="radian" autolimits="true"/>
+  <worldbody>
+    <body name="base">
+      <geom name="post" type="box" size="0.15 0.15 0.25" pos="0 0 0.25"/>
+      <body name="link_1" pos="0 0 0.5">
+        <joint name="j1" type="hinge" axis="0 0 1" range="-3 3"/>
+        <geom name="upper" type="box" size="0.5 0.05 0.05" pos="0.5 0 0"/>
+        <body name="link_2" pos="1 0 0">
+          <joint name="j2" type="hinge" axis="0 0 1" range="-2.8 2.8"/>
+          <geom name="knuckle" type="box" size="0.1 0.08 0.04" pos="0.1 0 0"/>
+          <body name="link_3" pos="0.2 0 0">
+            <joint name="j3" type="hinge" axis="0 0 1" range="-2.8 2.8"/>
+            <geom name="forearm" type="box" size="0.4 0.05 0.05" pos="0.4 0 0"/>
+            <body name="hand" pos="0.8 0 0">
+              <geom name="palm" type="box" size="0.05 0.15 0.05" pos="0.05 0 0"/>
+              <site name="tool0" pos="0.1 0 0"/>
+              <body name="finger_l" pos="0.15 0 0">
+                <joint name="fl" type="slide" axis="0 1 0" range="0.005 0.12"/>
+                <geom name="finger_l_box" type="box" size="0.05 0.02 0.03" pos="0.05 0 0"/>
+              </body>
+              <body name="finger_r" pos="0.15 0 0">
+                <joint name="fr" type="slide" axis="0 1 0" range="-0.12 -0.005"/>
+                <geom name="finger_r_box" type="box" size="0.05 0.02 0.03" pos="0.05 0 0"/>
+              </body>
+            </body>
+          </body>
+        </body>
+      </body>
+    </body>
+    <geom name="table" type="box" size="0.4 0.4 0.25" pos="1.2 1.1 0.25"/>
+  </worldbody>
+  <keyframe>
+    <key name="straight" qpos="0 0 0 0.06 -0.06"/>
+    <key name="folded" qpos="0.3 1.57 1.5 0.03 -0.03"/>
+    <key name="back" qpos="0 2.2 1.0 0.04 -0.04"/>
+  </keyframe>
+</mujoco>
+)";
+
 std::string cell_path(const test::TempDir& dir, const std::string& name) {
+  if (name == "folding_hand") return dir.write("folding_hand.xml", kFoldingHandCell);
   if (name == "one_link") return dir.write("one_link.xml", one_link_cell(kOneLinkObstacles));
   if (name == "hammer") return dir.write("hammer.xml", kHammerPropertyCell);
   if (name == "telescope") return dir.write("telescope.xml", kTelescopeCell);
@@ -272,7 +322,8 @@ class CertifyPropertyTest : public test::MujocoTestOf<::testing::TestWithParam<c
   }
   //! How many regions a test draws: the small test cells get more, `divisor` scales it down.
   int count(int divisor) const {
-    return property_count(cell_ == "one_link" || cell_ == "hammer" ? 1500 : 400) / divisor;
+    return property_count(cell_ == "one_link" || cell_ == "hammer" || cell_ == "folding_hand" ? 1500 : 400) /
+           divisor;
   }
   std::string trace() const { return "LEEWAY_CERTIFY_SEED=" + std::to_string(seed_) + ", cell " + cell_; }
   std::string cell_;
@@ -416,7 +467,8 @@ TEST_P(CertifyPropertyTest, CertifiedSegmentsAreFree) {
 }
 
 INSTANTIATE_TEST_SUITE_P(CertifyCells, CertifyPropertyTest,
-                         ::testing::Values("dallara", "baltico", "dlr", "one_link", "hammer", "telescope"));
+                         ::testing::Values("dallara", "baltico", "dlr", "rail_hall", "one_link", "hammer",
+                                           "telescope", "folding_hand"));
 
 class CertifyTest : public test::MujocoTest {};
 
@@ -851,6 +903,81 @@ TEST_F(CertifyTest, HingeBeforeASlideIsBoundedWithTheSlidesTravel) {
     EXPECT_FALSE(certifier.segment_free(lower, upper, lower, upper, stats))
         << "a colliding segment certified";
   }
+}
+
+// A planar arm (hinges about z, all links 0.1 m thick at z = 0.5) that folds its forearm back onto
+// its upper arm: upper arm x in [0, 1] on link_1 (j1 at the origin), an elbow knuckle without a geom
+// (j2 at x = 1), the forearm x in [0, 0.8] on link_3, whose hinge j3 is 0.2 m along link_2. With
+// j2 = pi/2 the j3 axis stands at (1, 0.2) and the forearm points along angle pi/2 + j3; past
+// j3 = pi/2 (angle pi + phi) its far lower corner, 0.8 along and 0.05 across, is at
+// y = 0.2 - 0.8 sin(phi) - 0.05 cos(phi), above the upper arm's top face y = 0.05 (x = 0.21 there),
+// so the clearance c is reached at phi(c) = asin((0.15 - c) / sqrt(0.6425)) - atan(0.05 / 0.8):
+// touch at j3 = pi/2 + 0.125826 = 1.696622 rad, 1 mm of clearance 1.27 mrad before it. j1 turns both
+// links alike and changes nothing: a bound that counted its motion could not prove any of it.
+const char* kFoldingCell = R"(<mujoco model="folding">
+  <compiler angle="radian" autolimits="true"/>
+  <worldbody>
+    <body name="link_1" pos="0 0 0.5">
+      <joint name="j1" type="hinge" axis="0 0 1" range="-3 3"/>
+      <geom name="upper" type="box" size="0.5 0.05 0.05" pos="0.5 0 0"/>
+      <body name="link_2" pos="1 0 0">
+        <joint name="j2" type="hinge" axis="0 0 1" range="-2.8 2.8"/>
+        <inertial pos="0 0 0" mass="1" diaginertia="0.01 0.01 0.01"/>
+        <body name="link_3" pos="0.2 0 0">
+          <joint name="j3" type="hinge" axis="0 0 1" range="-2.8 2.8"/>
+          <geom name="forearm" type="box" size="0.4 0.05 0.05" pos="0.4 0 0"/>
+          <site name="tool0" pos="0.8 0 0"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+)";
+
+double folding_touch(double clearance) {
+  const double kHalfPi = 1.5707963267948966;
+  return kHalfPi + std::asin((0.15 - clearance) / std::sqrt(0.6425)) - std::atan(0.05 / 0.8);
+}
+
+TEST_F(CertifyTest, FoldingArmCertifiedUpToItsElbowTouchMinusTheMargin) {
+  test::TempDir dir;
+  const Scene scene = Scene::load(dir.write("folding.xml", kFoldingCell));
+  ASSERT_EQ(scene.self_pairs().size(), 1u);  // upper arm and forearm; the knuckle has no geom
+  RobotState state(scene);
+  const double touch = folding_touch(0), limit = folding_touch(0.001);
+  EXPECT_NEAR(touch, 1.696622, 1e-6);
+  Eigen::VectorXd q(3);
+  q << 0.7, 1.5707963267948966, touch - 1e-4;
+  EXPECT_FALSE(state.in_collision(q));
+  EXPECT_NEAR(exact_clearance(state, q).distance, 1e-4 * (0.8 * std::cos(0.125826) - 0.05 * std::sin(0.125826)),
+              2e-6);
+  q[2] = touch + 1e-4;
+  EXPECT_TRUE(state.in_collision(q));
+  ASSERT_EQ(state.self_contacts(q).size(), 1u);
+  EXPECT_EQ(scene.geom_label(state.self_contacts(q)[0].geom2), "forearm");
+  // The largest certified upper bound of j3 from 1.2 rad, with j2 held and j1 held or free over
+  // +-0.3 rad: the same bound with about the same work, since j1 moves both links alike.
+  long leaves[2] = {0, 0};
+  for (const double j1_half : {0.0, 0.3}) {
+    SCOPED_TRACE("j1 half-width " + std::to_string(j1_half));
+    Certifier certifier(scene);
+    CertifyStats stats;
+    auto certified = [&](double upper_j3) {
+      Eigen::VectorXd lo(3), hi(3);
+      lo << -j1_half, 1.5707963267948966, 1.2;
+      hi << j1_half, 1.5707963267948966, upper_j3;
+      return certifier.region_free(lo, hi, stats);
+    };
+    double lo = 1.2, hi = 2.0;
+    ASSERT_TRUE(certified(lo));
+    ASSERT_FALSE(certified(hi));
+    for (int step = 0; step < 20; ++step) (certified((lo + hi) / 2) ? lo : hi) = (lo + hi) / 2;
+    EXPECT_LE(lo, limit + 1e-9) << "certified past the point 1 mm before the elbow touches";
+    EXPECT_GE(lo, limit - 0.003) << "the certificate keeps more than 3 mrad short of the margin";
+    leaves[j1_half > 0] = stats.leaves;
+  }
+  // The corner probes of a box that is also wide in j1 cost a few more leaves; the proof is the same.
+  EXPECT_LE(leaves[1], 2 * leaves[0]) << "a turn of j1 made the proof harder";
 }
 
 }  // namespace

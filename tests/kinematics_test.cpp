@@ -278,5 +278,27 @@ TEST_F(KinematicsTest, PartialKinematicsCoversSlidesOffsetAnchorsAndFixedChildre
   expect_partial_kinematics_exact(scene, 200);
 }
 
+// A configuration inside the Baltico patch-mould bounds of before self-collision was certified, found
+// by an independent checker (its own kinematics and separating-axis test): the wrist swings the
+// carried patch into the forearm, where MuJoCo's box-box function reports contacts 4.4 cm deep.
+// MuJoCo 2.2.2's box-box dist is half the face penetration (src/check.cpp), so the exact
+// separating-axis depth that leeway reports is twice that. The patch also reaches the wrist housing.
+TEST_F(KinematicsTest, TheCarriedPatchHitsTheForearmWhereAnIndependentCheckerFoundIt) {
+  const Scene scene = Scene::load(workcell("baltico"));
+  RobotState state(scene);
+  Eigen::VectorXd q(6);
+  q << 2.5954, -0.4684, -1.7424, 0.0074, -2.0930, -0.7205;
+  EXPECT_FALSE(state.obstacle_contact(q));
+  EXPECT_GE(state.self_contact(), 0);
+  EXPECT_TRUE(state.in_collision(q));
+  const auto self = state.self_contacts(q);
+  ASSERT_EQ(self.size(), 2u);
+  EXPECT_EQ(scene.geom_label(self[0].geom1), "link_4_tube_box");
+  EXPECT_EQ(scene.geom_label(self[0].geom2), "patch_box");
+  EXPECT_NEAR(self[0].depth, 2 * 0.044, 0.002);
+  EXPECT_EQ(scene.geom_label(self[1].geom1), "link_4_wrist_box");
+  EXPECT_EQ(scene.geom_label(self[1].geom2), "patch_box");
+}
+
 }  // namespace
 }  // namespace leeway

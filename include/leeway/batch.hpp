@@ -17,6 +17,7 @@ struct Expectations {
   std::optional<double> cf_min;          //!< Confidence Factor >= this (fraction, 0..1)
   std::optional<bool> certified;         //!< the safety stage certified every segment (or not)
   std::optional<double> mean_width_min;  //!< mean width of the bisected intervals >= this [rad]
+  std::optional<long> self_collisions_max;  //!< CF samples where the robot hits itself <= this
   std::optional<double> time_max;        //!< the method's time <= this [s]; a soft warning only
 };
 

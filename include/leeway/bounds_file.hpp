@@ -15,8 +15,9 @@
 namespace leeway {
 
 //! The safety stage's record in a bounds file: mode, whether every segment passed, per segment
-//! leaves/depth (certified) or samples/rounds (sampled), margin or epsilon, delta and N.
-nlohmann::json safety_json(const SafetyReport& report, const SafetyParams& params);
+//! leaves/depth (certified) or samples/rounds (sampled), margin or epsilon, delta and N; certified:
+//! the pairs proven apart (link-obstacle and self pairs, counted) and the excluded pairs by name.
+nlohmann::json safety_json(const Scene& scene, const SafetyReport& report, const SafetyParams& params);
 
 //! The "format" value of the bounds files bounds_json writes and read_bounds accepts.
 inline constexpr const char* kBoundsFormat = "leeway-bounds-1";

@@ -81,6 +81,9 @@ struct BoundsParams {
   //! fixed half-width around nominal of every hinge joint after the third (the wrist) [rad]
   double wrist_half_width = 0.2;
   double linear_axis_tolerance = 0.03;  //!< slide joints: half-width as a fraction of the joint's range
+  //! A probe where two robot geoms touch (Scene::self_pairs()) counts as colliding. Not in the
+  //! thesis (false, its probes see the volume only); the leeway preset sets it.
+  bool self_collision = false;
 };
 
 //! Confidence Factor (section 4.1).

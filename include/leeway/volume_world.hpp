@@ -93,6 +93,9 @@ class VolumeChecker {
   explicit VolumeChecker(const VolumeModel& world);
   //! True when a robot link touches an active volume box at q. @throws InputError on a bad q.
   bool in_collision(const Eigen::VectorXd& q);
+  //! True when two robot geoms (Scene::self_pairs()) touch at the configuration of the last
+  //! in_collision() call.
+  bool touches_itself() const { return robot_.self_contact() >= 0; }
   //! Number of collision checks so far.
   long checks() const { return checks_; }
   //! The data of the last check: with the mujoco checker the pool model's, contacts in

@@ -40,9 +40,9 @@ void print_safety(const SafetyReport& r, const SafetyParams& params) {
       std::cout << "safety: none (the thesis's bounds, not checked against the obstacles)\n";
       break;
     case SafetyMode::kCertified:
-      std::cout << "safety: certified, " << passed << " of " << n << " segments proven free (margin "
-                << format_number(params.margin) << " m; " << r.stats.leaves << " leaves, depth "
-                << r.stats.max_depth << ")"
+      std::cout << "safety: certified, " << passed << " of " << n
+                << " segments proven free of the cell and of itself (margin " << format_number(params.margin)
+                << " m; " << r.stats.leaves << " leaves, depth " << r.stats.max_depth << ")"
                 << (r.all_passed ? "" : "; NOT CERTIFIED where the nominal path is too close") << "\n";
       break;
     case SafetyMode::kSampled:

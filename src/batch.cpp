@@ -466,7 +466,8 @@ void judge(const Scenario& scenario, json& result) {
   const Expectations& x = scenario.expect;
   if (x.check) add("check", *x.check ? "check passes" : "check fails", *x.check, "check_passed", 0);
   if (x.cf_min) add("cf_min", "CF >= " + format_number(*x.cf_min), *x.cf_min, "cf", 1);
-  if (x.certified) add("certified", *x.certified ? "certified" : "not certified", *x.certified, "certified", 0);
+  if (x.certified)
+    add("certified", *x.certified ? "certified" : "not certified", *x.certified, "certified", 0);
   if (x.mean_width_min)
     add("mean_width_min", "mean width >= " + format_number(*x.mean_width_min) + " rad", *x.mean_width_min,
         "mean_width", 1);

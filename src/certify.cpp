@@ -122,7 +122,8 @@ Certifier::Certifier(const Scene& scene, CertifyOptions options)
   // "Self-collision"). `shared` counts the link's joints at or above the two geoms' deepest common
   // body: they move both geoms rigidly, so they do not change the pair's distance.
   std::vector<int> link_of(static_cast<size_t>(m.ngeom), -1);
-  for (size_t i = 0; i < links_.size(); ++i) link_of[static_cast<size_t>(links_[i].geom)] = static_cast<int>(i);
+  for (size_t i = 0; i < links_.size(); ++i)
+    link_of[static_cast<size_t>(links_[i].geom)] = static_cast<int>(i);
   auto chain = [&](int body) {
     std::vector<int> out;
     for (int b = body; b > 0; b = m.body_parentid[b]) out.push_back(b);
@@ -261,8 +262,8 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
     terms_ready = true;
   };
 
-  Obstacle other;       // a self pair's other robot geom, at c (grown by its own motion)
-  Box other_at_c;       // ... and as it is at c, for the centre test
+  Obstacle other;  // a self pair's other robot geom, at c (grown by its own motion)
+  Box other_at_c;  // ... and as it is at c, for the centre test
   for (int pair : pairs) {
     ++stats.pair_tests;
     // An obstacle pair (link, obstacle), or a self pair: the link against another robot geom. The

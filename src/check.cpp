@@ -132,7 +132,8 @@ CheckReport check_scene(const Scene& scene, const CheckOptions& options) {
     for (const auto& c : f.self_collisions)
       report.problems.push_back("keyframe '" + k.name + "': robot geoms '" + scene.geom_label(c.geom1) +
                                 "' and '" + scene.geom_label(c.geom2) + "' collide (self-collision, depth " +
-                                format_number(c.depth) + " m); exclude the pair if it is an artefact of the "
+                                format_number(c.depth) +
+                                " m); exclude the pair if it is an artefact of the "
                                 "collision shapes (docs/mjcf-conventions.md)");
     for (int j : f.limit_violations) {
       const auto& joint = scene.joints()[static_cast<size_t>(j)];
@@ -250,7 +251,8 @@ nlohmann::json to_json(const Scene& scene, const CheckReport& report) {
                      {"depth", c.depth}});
     json self = json::array();
     for (const auto& c : k.self_collisions)
-      self.push_back({{"a", scene.geom_label(c.geom1)}, {"b", scene.geom_label(c.geom2)}, {"depth", c.depth}});
+      self.push_back(
+          {{"a", scene.geom_label(c.geom1)}, {"b", scene.geom_label(c.geom2)}, {"depth", c.depth}});
     json lim = json::array();
     for (int j : k.limit_violations) {
       const auto& joint = scene.joints()[static_cast<size_t>(j)];

@@ -110,9 +110,7 @@ void RobotState::run_collision() {
   mj_collision(&scene_->model(), data_.get());
 }
 
-bool RobotState::in_collision(const Eigen::VectorXd& q) {
-  return obstacle_contact(q) || self_contact() >= 0;
-}
+bool RobotState::in_collision(const Eigen::VectorXd& q) { return obstacle_contact(q) || self_contact() >= 0; }
 
 int RobotState::self_contact() const {
   const mjModel& m = scene_->model();
@@ -141,7 +139,8 @@ std::vector<SelfContact> RobotState::self_contacts(const Eigen::VectorXd& q) {
     }
     out.push_back(c);
   }
-  std::sort(out.begin(), out.end(), [](const SelfContact& a, const SelfContact& b) { return a.depth > b.depth; });
+  std::sort(out.begin(), out.end(),
+            [](const SelfContact& a, const SelfContact& b) { return a.depth > b.depth; });
   return out;
 }
 

@@ -371,9 +371,10 @@ void require_free(RobotState& state, const Eigen::VectorXd& q, double clearance,
         (contacts.size() > 1 ? " (and " + std::to_string(contacts.size() - 1) + " more contacts)" : ""));
   const auto self = state.self_contacts(q);
   if (!self.empty())
-    throw InputError(what + " is in self-collision: robot geoms '" + scene.geom_label(self[0].geom1) + "' and '" +
-                     scene.geom_label(self[0].geom2) + "' overlap by " + format_number(self[0].depth) + " m" +
-                     (self.size() > 1 ? " (and " + std::to_string(self.size() - 1) + " more self pairs)" : ""));
+    throw InputError(
+        what + " is in self-collision: robot geoms '" + scene.geom_label(self[0].geom1) + "' and '" +
+        scene.geom_label(self[0].geom2) + "' overlap by " + format_number(self[0].depth) + " m" +
+        (self.size() > 1 ? " (and " + std::to_string(self.size() - 1) + " more self pairs)" : ""));
   if (clearance > 0) {
     const Clearance c = state.clearance(q);
     if (c.distance < clearance)

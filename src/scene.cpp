@@ -305,7 +305,8 @@ void Scene::find_self_pairs() {
   for (int t = 0; t < m.ntext; ++t) {
     const std::string name = object_name(m, mjOBJ_TEXT, t);
     if (name.rfind("leeway_exclude", 0) != 0) continue;
-    std::istringstream words(std::string(m.text_data + m.text_adr[t], static_cast<size_t>(std::max(0, m.text_size[t] - 1))));
+    std::istringstream words(
+        std::string(m.text_data + m.text_adr[t], static_cast<size_t>(std::max(0, m.text_size[t] - 1))));
     std::vector<std::string> geoms;
     for (std::string w; words >> w;) geoms.push_back(w);
     if (geoms.size() != 2)
@@ -332,7 +333,8 @@ void Scene::find_self_pairs() {
 
   std::vector<int> robot;
   for (int g = 0; g < m.ngeom; ++g)
-    if (roles_[static_cast<size_t>(g)] == GeomRole::kLink || roles_[static_cast<size_t>(g)] == GeomRole::kRobotBase)
+    if (roles_[static_cast<size_t>(g)] == GeomRole::kLink ||
+        roles_[static_cast<size_t>(g)] == GeomRole::kRobotBase)
       robot.push_back(g);
   auto part = [&](int g) { return m.body_weldid[m.geom_bodyid[g]]; };
   auto parent_part = [&](int w) { return w == 0 ? -1 : m.body_weldid[m.body_parentid[w]]; };

@@ -949,8 +949,8 @@ TEST_F(CertifyTest, FoldingArmCertifiedUpToItsElbowTouchMinusTheMargin) {
   Eigen::VectorXd q(3);
   q << 0.7, 1.5707963267948966, touch - 1e-4;
   EXPECT_FALSE(state.in_collision(q));
-  EXPECT_NEAR(exact_clearance(state, q).distance, 1e-4 * (0.8 * std::cos(0.125826) - 0.05 * std::sin(0.125826)),
-              2e-6);
+  EXPECT_NEAR(exact_clearance(state, q).distance,
+              1e-4 * (0.8 * std::cos(0.125826) - 0.05 * std::sin(0.125826)), 2e-6);
   q[2] = touch + 1e-4;
   EXPECT_TRUE(state.in_collision(q));
   ASSERT_EQ(state.self_contacts(q).size(), 1u);

@@ -136,7 +136,10 @@ TEST(ParamsJsonTest, KeysAreTheFieldNames) {
   EXPECT_EQ(j.at("height_map").size(), 6u);
   EXPECT_EQ(j.at("volume").size(), 14u);  // 13 of section 4.1 and 3.2 plus trail_margin
   EXPECT_EQ(j.at("categorize").size(), 2u);
-  EXPECT_EQ(j.at("bounds").size(), 4u);
+  EXPECT_EQ(j.at("bounds").size(), 5u);  // four of sections 3.3 and 4.2.3 plus self_collision
+  EXPECT_EQ(to_json(Params{}).at("bounds").at("self_collision"), false);
+  EXPECT_EQ(to_json(preset_params("leeway")).at("bounds").at("self_collision"), true);
+  EXPECT_EQ(to_json(preset_params("thesis")).at("bounds").at("self_collision"), false);
   EXPECT_EQ(j.at("cf").size(), 3u);
 }
 

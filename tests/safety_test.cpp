@@ -232,12 +232,14 @@ TEST_F(CliSafetyTest, CertifiedBoundsScoreNoCollisionOnTheThreeCells) {
 // find none.
 TEST_F(CliSafetyTest, BalticoPatchMouldIsCertifiedFreeOfItself) {
   const std::string guide = file("guide.json"), safe = file("safe.json");
-  const auto g = run_cli("bounds " + workcell("baltico") + " --from patch --to mould --safety none --out " + guide);
+  const auto g =
+      run_cli("bounds " + workcell("baltico") + " --from patch --to mould --safety none --out " + guide);
   ASSERT_EQ(g.exit_code, 0) << g.out;
   const auto gc = run_cli("cf " + workcell("baltico") + " " + guide + " --json");
   ASSERT_EQ(gc.exit_code, 0) << gc.out;
   const json guide_cf = json::parse(gc.out);
-  EXPECT_GT(guide_cf.at("self_collisions").get<long>(), 0) << "the guide no longer lets the patch hit the arm";
+  EXPECT_GT(guide_cf.at("self_collisions").get<long>(), 0)
+      << "the guide no longer lets the patch hit the arm";
   EXPECT_EQ(guide_cf.at("counts"), "obstacle collisions");
   EXPECT_EQ(guide_cf.at("collisions"), guide_cf.at("obstacle_collisions"));
 

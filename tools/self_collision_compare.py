@@ -68,6 +68,7 @@ def main():
             rows.append({"path": f"{cell} {src}-{dst}", "base_ms": bt, "new_ms": nt,
                          "base_leaves": b["safety"]["leaves"], "new_leaves": n["safety"]["leaves"],
                          "base_ratio": ratio(b), "new_ratio": ratio(n),
+                         "base_width": widths(b)[0], "new_width": widths(n)[0],
                          "base_certified": b["safety"]["certified"], "new_certified": n["safety"]["certified"],
                          "base_obstacle": cb["obstacle_collisions"], "base_self": cb["self_collisions"],
                          "new_obstacle": cn["obstacle_collisions"], "new_self": cn["self_collisions"],
@@ -77,11 +78,13 @@ def main():
                   f"new {nt:.0f} ms ratio {r['new_ratio']:.4f} obstacle {r['new_obstacle']} self {r['new_self']}",
                   flush=True)
     lines = ["| path | safety stage [ms] base -> new | leaves base -> new | certified/guide j1-j3 width "
-             "base -> new | cf --self of base bounds: obstacle, self | of new bounds: obstacle, self | certified |",
-             "|---|---:|---:|---:|---:|---:|---|"]
+             "base -> new | certified j1-j3 width [rad] base -> new | cf --self of base bounds: obstacle, self | "
+             "of new bounds: obstacle, self | certified |",
+             "|---|---:|---:|---:|---:|---:|---:|---|"]
     for r in rows:
         lines.append(f"| {r['path']} | {r['base_ms']:.0f} -> {r['new_ms']:.0f} | {r['base_leaves']:,} -> "
-                     f"{r['new_leaves']:,} | {r['base_ratio']:.4f} -> {r['new_ratio']:.4f} | {r['base_obstacle']}, "
+                     f"{r['new_leaves']:,} | {r['base_ratio']:.4f} -> {r['new_ratio']:.4f} | "
+                     f"{r['base_width']:.3f} -> {r['new_width']:.3f} | {r['base_obstacle']}, "
                      f"{r['base_self']} | {r['new_obstacle']}, {r['new_self']} | {r['new_certified']} |")
     tb, tn = sum(r["base_ms"] for r in rows), sum(r["new_ms"] for r in rows)
     mb = statistics.mean(r["base_ratio"] for r in rows)
@@ -89,6 +92,8 @@ def main():
     lines.append(f"| **total / mean** | **{tb:.0f} -> {tn:.0f}** ({tn / tb:.2f}x) | "
                  f"{sum(r['base_leaves'] for r in rows):,} -> {sum(r['new_leaves'] for r in rows):,} | "
                  f"**{mb:.4f} -> {mn:.4f}** ({100 * (mn / mb - 1):+.1f} %) | "
+                 f"{statistics.mean(r['base_width'] for r in rows):.3f} -> "
+                 f"{statistics.mean(r['new_width'] for r in rows):.3f} | "
                  f"{sum(r['base_obstacle'] for r in rows)}, {sum(r['base_self'] for r in rows)} | "
                  f"{sum(r['new_obstacle'] for r in rows)}, {sum(r['new_self'] for r in rows)} | |")
     lines.append("")

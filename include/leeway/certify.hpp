@@ -2,8 +2,9 @@
 //! @file certify.hpp
 //! Certified free regions of joint space: a conservative test that every configuration in a box
 //! of joint values (or in the interpolated bounds between two waypoints) keeps every robot link
-//! clear of every real obstacle and of the robot's other geoms (Scene::self_pairs()). Not a sample: a proof by bounds. docs/algorithm.md ("Certified
-//! intervals") derives the bounds and the argument that makes each conservative.
+//! clear of every real obstacle and of the robot's other geoms (Scene::self_pairs()). Not a sample: a proof
+//! by bounds. docs/algorithm.md ("Certified intervals") derives the bounds and the argument that makes each
+//! conservative.
 
 #include <Eigen/Core>
 #include <string>
@@ -47,8 +48,8 @@ struct CertifyFailure {
   int link_geom = -1;            //!< the pair that could not be separated
   int obstacle_geom = -1;        //!< an obstacle, or the other robot geom when `self`
   bool self = false;             //!< the pair is two robot geoms (self-collision)
-  int split_joint = -1;  //!< the joint whose motion contributes most to the failing pair
-  bool budget = false;   //!< the leaf budget or depth ran out (rather than a leaf of width 0)
+  int split_joint = -1;          //!< the joint whose motion contributes most to the failing pair
+  bool budget = false;           //!< the leaf budget or depth ran out (rather than a leaf of width 0)
   //! The leaf's centre configuration itself comes within the margin of the obstacle: no
   //! subdivision can certify a region that contains it.
   bool centre_hits = false;
@@ -57,8 +58,8 @@ struct CertifyFailure {
   double gap = 0.0;
 };
 
-//! Proves joint-space regions free against the scene's obstacles and the robot itself. One object per thread (it owns
-//! one mjData); the Scene must outlive it.
+//! Proves joint-space regions free against the scene's obstacles and the robot itself. One object per thread
+//! (it owns one mjData); the Scene must outlive it.
 class Certifier {
  public:
   explicit Certifier(const Scene& scene, CertifyOptions options = {});
@@ -146,7 +147,7 @@ class Certifier {
   std::vector<Obstacle> obstacles_;
   std::vector<bool> prismatic_;
   std::vector<SelfPair> self_pairs_;
-  int obstacle_pairs_ = 0;      //!< pair indices below it are (link, obstacle), link-major; the rest self pairs
+  int obstacle_pairs_ = 0;  //!< pair indices below it are (link, obstacle), link-major; the rest self pairs
   std::vector<int> all_pairs_;  //!< every pair index
 };
 

@@ -29,8 +29,8 @@ struct KeyframeFindings {
   Pose tool;
   std::vector<Contact> collisions;
   std::vector<SelfContact> self_collisions;  //!< robot geoms touching each other
-  std::vector<int> limit_violations;  //!< joint indices
-  Clearance clearance;                //!< closest link-obstacle pair
+  std::vector<int> limit_violations;         //!< joint indices
+  Clearance clearance;                       //!< closest link-obstacle pair
 };
 
 //! Findings for one goal site.

@@ -35,23 +35,24 @@ int run_cf(const CfArgs& args) {
   const auto wb = read_bounds(args.bounds, scene);
   const auto r = confidence_factor(scene, wb, args.params, args.threads);
   if (args.json) {
-    nlohmann::json out = {{"cf", r.cf},
-                          {"ci95", {r.ci_low, r.ci_high}},
-                          {"worst_window", {{"index", r.worst_window}, {"cf", r.worst_window_cf}}},
-                          {"window_cf", r.window_cf},
-                          {"samples", r.samples},
-                          {"collisions", r.collisions},
-                          {"counts", args.params.self ? "obstacle and self collisions" : "obstacle collisions"},
-                          {"obstacle_collisions", r.obstacle_collisions},
-                          {"self_collisions", r.self_collisions},
-                          {"any_collisions", r.any_collisions},
-                          {"windows", args.params.windows},
-                          {"windows_by", r.timed ? "time" : "path parameter"},
-                          {"duration", r.duration},
-                          {"seed", args.params.seed},
-                          {"units",
-                           "cf and ci95 are fractions (1 = 100 %); duration in seconds when windows_by "
-                           "is time, else in segments"}};
+    nlohmann::json out = {
+        {"cf", r.cf},
+        {"ci95", {r.ci_low, r.ci_high}},
+        {"worst_window", {{"index", r.worst_window}, {"cf", r.worst_window_cf}}},
+        {"window_cf", r.window_cf},
+        {"samples", r.samples},
+        {"collisions", r.collisions},
+        {"counts", args.params.self ? "obstacle and self collisions" : "obstacle collisions"},
+        {"obstacle_collisions", r.obstacle_collisions},
+        {"self_collisions", r.self_collisions},
+        {"any_collisions", r.any_collisions},
+        {"windows", args.params.windows},
+        {"windows_by", r.timed ? "time" : "path parameter"},
+        {"duration", r.duration},
+        {"seed", args.params.seed},
+        {"units",
+         "cf and ci95 are fractions (1 = 100 %); duration in seconds when windows_by "
+         "is time, else in segments"}};
     std::cout << out.dump(2) << "\n";
   } else {
     std::cout << std::fixed << std::setprecision(4) << "CF " << 100 * r.cf << " % (95 % CI " << 100 * r.ci_low
@@ -60,7 +61,8 @@ int run_cf(const CfArgs& args) {
               << 100 * r.worst_window_cf << " %\n";
     std::cout << "collisions: " << r.obstacle_collisions << " with obstacles, " << r.self_collisions
               << " self-collisions, " << r.any_collisions << " samples with either"
-              << (args.params.self ? " (CF counts both: --self)\n" : " (CF counts obstacles only; --self counts both)\n");
+              << (args.params.self ? " (CF counts both: --self)\n"
+                                   : " (CF counts obstacles only; --self counts both)\n");
     if (r.timed)
       std::cout << std::setprecision(3) << "windows: " << args.params.windows << " of equal duration, "
                 << r.duration / args.params.windows

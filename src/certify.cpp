@@ -162,6 +162,28 @@ Certifier::Certifier(const Scene& scene, CertifyOptions options)
   obstacle_pairs_ = static_cast<int>(links_.size() * obstacles_.size());
   all_pairs_.resize(static_cast<size_t>(obstacle_pairs_) + self_pairs_.size());
   for (size_t i = 0; i < all_pairs_.size(); ++i) all_pairs_[i] = static_cast<int>(i);
+  // The joints each pair depends on: a link's chain against an obstacle; for a self pair, the
+  // joints below the two geoms' deepest common body.
+  pairs_moved_by_.assign(static_cast<size_t>(scene.dof()), {});
+  for (int pair : all_pairs_) {
+    std::vector<bool> moves(static_cast<size_t>(scene.dof()), false);
+    if (pair < obstacle_pairs_) {
+      for (int r : links_[static_cast<size_t>(pair / static_cast<int>(obstacles_.size()))].joints)
+        moves[static_cast<size_t>(r)] = true;
+    } else {
+      const SelfPair& sp = self_pairs_[static_cast<size_t>(pair - obstacle_pairs_)];
+      const auto& own = links_[static_cast<size_t>(sp.link)].joints;
+      for (size_t p = static_cast<size_t>(sp.shared); p < own.size(); ++p)
+        moves[static_cast<size_t>(own[p])] = true;
+      if (sp.other_link >= 0) {
+        const auto& other = links_[static_cast<size_t>(sp.other_link)].joints;
+        for (size_t p = static_cast<size_t>(sp.other_shared); p < other.size(); ++p)
+          moves[static_cast<size_t>(other[p])] = true;
+      }
+    }
+    for (int r = 0; r < scene.dof(); ++r)
+      if (moves[static_cast<size_t>(r)]) pairs_moved_by_[static_cast<size_t>(r)].push_back(pair);
+  }
 }
 
 bool Certifier::leaf_free(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, CertifyStats& stats,
@@ -535,7 +557,8 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
 }
 
 bool Certifier::region_free_impl(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
-                                 CertifyStats& stats, CertifyFailure* failure, long budget) {
+                                 CertifyStats& stats, CertifyFailure* failure, long budget,
+                                 const std::vector<int>& pairs) {
   // Worst-first refinement: the failing leaf whose bound misses by most is split first, so a region
   // that cannot be certified within max_depth fails after about 2 max_depth leaves instead of after
   // certifying everything around its hard spot; a free region costs the same as any order.
@@ -561,7 +584,7 @@ bool Certifier::region_free_impl(const Eigen::VectorXd& lower, const Eigen::Vect
     return true;
   };
   Cell root{lower, upper, 0, {}};
-  root.pairs = all_pairs_;
+  root.pairs = pairs;
   if (!test(std::move(root))) return false;
   while (!heap.empty()) {
     std::pop_heap(heap.begin(), heap.end(), worse);
@@ -653,15 +676,18 @@ bool Certifier::region_free(const Eigen::VectorXd& lower, const Eigen::VectorXd&
                             CertifyFailure* failure) {
   check_box(*scene_, lower, upper);
   if (!probe(lower, upper, (lower + upper) / 2, stats, failure)) return false;
-  return region_free_impl(lower, upper, stats, failure, options_.max_leaves);
+  return region_free_impl(lower, upper, stats, failure, options_.max_leaves, all_pairs_);
 }
 
 bool Certifier::segment_free(const Eigen::VectorXd& lower_a, const Eigen::VectorXd& upper_a,
                              const Eigen::VectorXd& lower_b, const Eigen::VectorXd& upper_b,
                              CertifyStats& stats, CertifyFailure* failure,
-                             std::vector<std::pair<double, double>>* proven) {
+                             std::vector<std::pair<double, double>>* proven, int grown_joint) {
   check_box(*scene_, lower_a, upper_a);
   check_box(*scene_, lower_b, upper_b);
+  if (grown_joint >= scene_->dof()) throw InputError("certify: no joint " + std::to_string(grown_joint));
+  const std::vector<int>& pairs =
+      grown_joint < 0 ? all_pairs_ : pairs_moved_by_[static_cast<size_t>(grown_joint)];
   constexpr double kMinDt = 1.0 / (1 << 20);
   const long start = stats.leaves;
   std::vector<std::pair<double, double>> stack = {{0.0, 1.0}};
@@ -709,7 +735,7 @@ bool Certifier::segment_free(const Eigen::VectorXd& lower_a, const Eigen::Vector
     const bool worth_splitting = (motion.array() > 0.05 * half.array() + 1e-4).any();
     const long share = splittable && worth_splitting ? std::max(64L, remaining / 16) : remaining;
     CertifyFailure local;
-    if (region_free_impl(lo, hi, stats, &local, std::min(share, remaining))) {
+    if (region_free_impl(lo, hi, stats, &local, std::min(share, remaining), pairs)) {
       if (proven) proven->emplace_back(t0, t1);
       continue;
     }

@@ -92,11 +92,12 @@ using detail::unit;
 // shrunk extent is then bisected back toward its guide value, first against the probe (cheap),
 // then against the certificate (kRegrowSteps steps, each proving only the slab the growth adds),
 // for this segment and for the neighbouring
-// segments that share the regrown waypoint and are already certified (`check_previous`,
-// `check_next`). `guide` holds the extents before the safety stage. A segment that cannot
-// be certified keeps only its nominal values.
+// segments that share the regrown waypoint and ran before (`check_previous`, `check_next`; whether
+// they were certified: `previous_certified`, `next_certified`). `guide` holds the extents before
+// the safety stage. A segment that cannot be certified keeps only its nominal values.
 SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& guide, size_t a, size_t b,
-                              bool check_previous, bool check_next, CertifyStats& total) {
+                              bool check_previous, bool check_next, bool previous_certified,
+                              bool next_certified, CertifyStats& total) {
   SegmentSafety s;
   CertifyStats stats;
   const int n = static_cast<int>(e.q[a].size());
@@ -203,7 +204,11 @@ SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& g
     CertifyOptions thin = normal;
     thin.max_leaves = std::max(64L, normal.max_leaves / budget_divisor);
     certifier.set_options(thin);
-    const bool free = certifier.segment_free(lo[0], hi[0], lo[1], hi[1], stats, nullptr);
+    // On a certified segment only the pairs joint i moves need a proof: the others stay apart over
+    // the slab (Certifier::segment_free). On a neighbour that was not certified, every pair.
+    const bool region_certified = (p == a && r == b) || (p < a ? previous_certified : next_certified);
+    const bool free = certifier.segment_free(lo[0], hi[0], lo[1], hi[1], stats, nullptr, nullptr,
+                                             region_certified ? i : -1);
     certifier.set_options(normal);
     return free;
   };
@@ -355,8 +360,10 @@ SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, 
           const size_t s = jobs[static_cast<size_t>(i)];
           const bool previous = s > 0 && phase > 0;
           const bool next = s + 1 < segments && phase == phases - 1;
+          // The neighbours ran in earlier phases: their outcome is settled.
           report.segments[s] = certify_segment(*certifier, e, guide, s, std::min(s + 1, bounds.size() - 1),
-                                               previous, next, stats[s]);
+                                               previous, next, previous && report.segments[s - 1].passed,
+                                               next && report.segments[s + 1].passed, stats[s]);
         };
       });
     }

@@ -79,10 +79,16 @@ class Certifier {
   //! bounds that contained these at every t (an earlier call before the bounds shrank): they are
   //! skipped, and the stretches this call proves are appended. The caller keeps it only while the
   //! bounds shrink.
+  //! `grown_joint` (>= 0): the segment is a slab that grows a certified region in this joint only
+  //! (at every t, joint grown_joint between the region's bound and the new one, the other joints
+  //! within the region's bounds). A pair that this joint does not move is then apart over the slab
+  //! because it is apart over the region (move the joint back to the region's bound: the pair's
+  //! geometry is the same), so only the pairs it moves are proven. The caller vouches that the
+  //! region is certified.
   bool segment_free(const Eigen::VectorXd& lower_a, const Eigen::VectorXd& upper_a,
                     const Eigen::VectorXd& lower_b, const Eigen::VectorXd& upper_b, CertifyStats& stats,
                     CertifyFailure* failure = nullptr,
-                    std::vector<std::pair<double, double>>* proven = nullptr);
+                    std::vector<std::pair<double, double>>* proven = nullptr, int grown_joint = -1);
 
   //! A quick necessary test, not a proof: exact checks (the margin included) of the corners and
   //! centre of the bounds at t = 0, 1/4, 1/2, 3/4, 1 and of `samples` random configurations of the
@@ -132,8 +138,9 @@ class Certifier {
 
   bool leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, std::vector<int>& pairs,
                       CertifyStats& stats, CertifyFailure* failure, const Eigen::VectorXd* blame = nullptr);
+  //! `pairs`: the pairs to prove at the root (all_pairs_, or a slab's pairs_moved_by_).
   bool region_free_impl(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, CertifyStats& stats,
-                        CertifyFailure* failure, long budget);
+                        CertifyFailure* failure, long budget, const std::vector<int>& pairs);
   //! Exact tests of the box's centre and corners (random points when there are more than 256
   //! corners): false, with `failure` at the first point within the margin of an obstacle, when one
   //! is. Such a region can never be certified, however finely it is split.
@@ -149,6 +156,8 @@ class Certifier {
   std::vector<SelfPair> self_pairs_;
   int obstacle_pairs_ = 0;  //!< pair indices below it are (link, obstacle), link-major; the rest self pairs
   std::vector<int> all_pairs_;  //!< every pair index
+  //! Per robot joint: the pairs whose distance it can change (see segment_free's grown_joint).
+  std::vector<std::vector<int>> pairs_moved_by_;
 };
 
 }  // namespace leeway

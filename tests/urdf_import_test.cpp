@@ -707,6 +707,27 @@ TEST(UrdfImportCliTest, ImportAndNewCellWriteAndPrintTheExcludes) {
   EXPECT_EQ(nlohmann::json::parse(check.out).at("robot").at("excluded_pairs").size(), 2u);
 }
 
+// The bundled robot mjcf/robots/wide_elbow.xml (and its excludes) is what import-urdf writes from
+// tests/data/urdf/wide_elbow.urdf; its cell passes the check (workcells_test.cpp).
+TEST_F(UrdfImportTest, TheBundledWideElbowRobotIsTheImportOfItsUrdf) {
+  const UrdfImport robot = import_urdf(kUrdfDir + "/wide_elbow.urdf");
+  auto read = [](const std::string& path) {
+    std::ifstream in(path);
+    return std::string((std::istreambuf_iterator<char>(in)), {});
+  };
+  EXPECT_EQ(robot.mjcf, read(std::string(LEEWAY_MJCF_DIR) + "/robots/wide_elbow.xml"));
+  EXPECT_EQ(robot.excludes_mjcf, read(std::string(LEEWAY_MJCF_DIR) + "/robots/wide_elbow_excludes.xml"));
+  EXPECT_EQ(robot.joints.size(), 6u);
+  EXPECT_EQ(robot.boxes, 9);
+  // 9 boxes on 7 parts (the forearm's two, link_6's flange and gripper): 36 pairs, 2 within one
+  // part and 9 parent and child; none touches at zero.
+  EXPECT_TRUE(robot.excludes.empty());
+  EXPECT_EQ(robot.self_pairs, 25);
+  const Scene s = Scene::load(test::workcell("wide_elbow"));
+  EXPECT_DOUBLE_EQ(s.joints()[2].lower, -3.14);
+  EXPECT_DOUBLE_EQ(s.joints()[2].upper, 4.61);
+}
+
 // A joint loop is refused, and the refused model does not leak: urdfdom's links own their children
 // (shared_ptr), so the loop was a cycle of owners that outlived the import (found by
 // fuzz/fuzz_urdf.cpp; fuzz/regressions/urdf/joint_loop_leak.urdf). Needs LeakSanitizer

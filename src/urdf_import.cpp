@@ -197,8 +197,8 @@ std::vector<std::string> split_paths(const std::string& list) {
 struct Geom {
   std::string name, comment;
   std::string link;  // the URDF link it came from (SRDF entries name links)
-  Isometry3d pose;  // in the body's frame
-  Vector3d half;    // [m]
+  Isometry3d pose;   // in the body's frame
+  Vector3d half;     // [m]
 };
 
 struct Body {

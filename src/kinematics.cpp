@@ -144,6 +144,22 @@ std::vector<SelfContact> RobotState::self_contacts(const Eigen::VectorXd& q) {
   return out;
 }
 
+std::vector<SelfContact> self_contacts_within(RobotState& state, const Eigen::VectorXd& q, double tolerance) {
+  std::vector<SelfContact> out = state.self_contacts(q);
+  const mjModel& m = state.scene().model();
+  for (const RobotPair& p : state.scene().self_pairs()) {
+    if (m.geom_type[p.geom1] != mjGEOM_BOX || m.geom_type[p.geom2] != mjGEOM_BOX) continue;
+    if (std::any_of(out.begin(), out.end(),
+                    [&](const SelfContact& c) { return c.geom1 == p.geom1 && c.geom2 == p.geom2; }))
+      continue;
+    if (box_distance(geom_box(m, state.data(), p.geom1), geom_box(m, state.data(), p.geom2)) <= tolerance)
+      out.push_back({p.geom1, p.geom2, 0.0});
+  }
+  std::stable_sort(out.begin(), out.end(),
+                   [](const SelfContact& a, const SelfContact& b) { return a.depth > b.depth; });
+  return out;
+}
+
 bool RobotState::obstacle_contact(const Eigen::VectorXd& q) {
   set(q);
   const mjModel& m = scene_->model();

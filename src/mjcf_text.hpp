@@ -66,4 +66,26 @@ inline std::string comment_text(std::string s) {
   return s;
 }
 
+//! `text` as an XML comment `<!-- text -->` starting at column `indent`, its words wrapped so that
+//! lines stay within 100 columns where the words allow (continuation lines under the text's start).
+//! Ends with a line feed.
+inline std::string wrapped_comment(const std::string& text, size_t indent) {
+  const std::string pad(indent, ' ');
+  std::string out = pad + "<!--", line_start = pad + "     ";
+  size_t column = out.size();
+  std::istringstream words(comment_text(text));
+  for (std::string w; words >> w;) {
+    if (column + 1 + w.size() > 100 && column > line_start.size()) {
+      out += "\n" + line_start;
+      column = line_start.size();
+    } else {
+      out += ' ';
+      ++column;
+    }
+    out += w;
+    column += w.size();
+  }
+  return out + " -->\n";
+}
+
 }  // namespace leeway::detail

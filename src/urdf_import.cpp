@@ -1,6 +1,7 @@
 #include "leeway/urdf_import.hpp"
 
 #include <console_bridge/console.h>
+#include <tinyxml.h>
 #include <urdf_parser/urdf_parser.h>
 
 #include <Eigen/Geometry>
@@ -16,6 +17,9 @@
 #include <set>
 #include <sstream>
 
+#include "leeway/file_io.hpp"
+#include "leeway/kinematics.hpp"
+#include "leeway/mujoco_util.hpp"
 #include "leeway/scene.hpp"
 #include "leeway/stl.hpp"
 #include "mjcf_text.hpp"
@@ -29,6 +33,9 @@ using Eigen::Vector3d;
 
 constexpr double kTwoPi = 6.283185307179586;
 constexpr double kMinHalfSize = 5e-4;  // [m] thinner boxes are thickened to this half-size (MuJoCo needs > 0)
+// [m] boxes this close at the reference configuration count as touching: boxes meeting face to face
+// at a joint touch or not by rounding.
+constexpr double kTouch = 1e-6;
 constexpr const char* kLinkRgba = "0.93 0.47 0.10 1";
 constexpr const char* kBaseRgba = "0.35 0.35 0.38 1";
 
@@ -189,8 +196,9 @@ std::vector<std::string> split_paths(const std::string& list) {
 
 struct Geom {
   std::string name, comment;
-  Isometry3d pose;  // in the body's frame
-  Vector3d half;    // [m]
+  std::string link;  // the URDF link it came from (SRDF entries name links)
+  Isometry3d pose;   // in the body's frame
+  Vector3d half;     // [m]
 };
 
 struct Body {
@@ -244,7 +252,9 @@ class Importer {
     if (!moving_geoms)
       throw InputError(file_ + ": no <collision> element on the links that move (below joint '" +
                        bodies_[1].joint->name + "'); leeway checks collisions of those links");
-    return write(base->name, tool->name);
+    UrdfImport out = write(base->name, tool->name);
+    find_excludes(out);
+    return out;
   }
 
  private:
@@ -443,6 +453,7 @@ class Importer {
           g.half[k] = kMinHalfSize;
         }
       g.name = geom_name(link.name, c->name, collisions.size() > 1 ? index : 0);
+      g.link = link.name;
       g.comment = (via.empty() ? "" : via + ", ") + "collision " + std::to_string(index) +
                   (c->name.empty() ? "" : " '" + c->name + "'") + ": " + shape;
       bodies_[b].geoms.push_back(g);
@@ -515,7 +526,10 @@ class Importer {
       << "  merged into it. Collision: one box per URDF <collision> element (a box exactly, a cylinder as\n"
       << "  its tight box, a sphere as its cube, an STL mesh as its axis-aligned bounding box in the\n"
       << "  mesh's frame): the boxes contain the URDF's shapes, so leeway's checks err on the safe side.\n"
-      << "  Robot geoms: contype=\"1\" conaffinity=\"0\" (they touch obstacles, never each other).\n";
+      << "  Robot geoms: contype=\"1\" conaffinity=\"0\" (they touch obstacles); leeway checks them\n"
+      << "  against each other by its own rule (docs/mjcf-conventions.md, \"Self-collision\"). The pairs\n"
+      << "  excluded from that check are in the second fragment written beside this one\n"
+      << "  (NAME_excludes.xml for NAME.xml), which the cell includes at its top level.\n";
     for (const auto& n : notes_) x << "  Note: " << comment_text(n) << "\n";
     x << "-->\n<mujoco>\n";
     std::string indent = "  ";
@@ -567,6 +581,152 @@ class Importer {
     return out;
   }
 
+  // The fragment's bodies inside a world body: a cell leeway's Scene can load.
+  std::string as_cell(const std::string& fragment, const std::string& custom) const {
+    const size_t a = fragment.find("<mujoco>\n"), b = fragment.rfind("</mujoco>");
+    LEEWAY_DEMAND(a != std::string::npos && b != std::string::npos && a < b);
+    return "<mujoco>\n<compiler angle=\"radian\" autolimits=\"true\"/>\n" + custom + "<worldbody>\n" +
+           fragment.substr(a + 9, b - a - 9) + "</worldbody>\n</mujoco>\n";
+  }
+
+  Scene load_cell(const std::string& text) const {
+    try {
+      return Scene::from_model(load_model_text(text, file_ + ".leeway.xml"), file_);
+    } catch (const InputError& e) {
+      throw InputError(file_ + ": the imported robot does not load as a leeway robot: " + e.what());
+    }
+  }
+
+  // The self-collision pairs to exclude (UrdfImport::excludes) and their fragment.
+  void find_excludes(UrdfImport& out) {
+    const Scene scene = load_cell(as_cell(out.mjcf, ""));
+    const mjModel& m = scene.model();
+    const Eigen::VectorXd q =
+        Eigen::VectorXd::Zero(scene.dof()).cwiseMax(scene.lower_limits()).cwiseMin(scene.upper_limits());
+    for (int i = 0; i < q.size(); ++i) out.reference += (i ? " " : "") + num(q[i]);
+    auto key = [](int a, int b) { return std::make_pair(std::min(a, b), std::max(a, b)); };
+    std::map<std::pair<int, int>, std::vector<std::string>> why;
+    std::map<std::pair<int, int>, double> depth;
+    RobotState state(scene);
+    for (const SelfContact& c : self_contacts_within(state, q, kTouch)) {
+      depth[key(c.geom1, c.geom2)] = c.depth;
+      why[key(c.geom1, c.geom2)].push_back(
+          (c.depth > kTouch ? "the boxes overlap by " + format_number(c.depth) + " m"
+                            : "the boxes touch (within " + num(kTouch) + " m)") +
+          " at the reference configuration (every joint at 0 or the limit nearest 0), where the arm is "
+          "taken to stand clear of itself: an artefact of the box approximation; check it");
+    }
+    std::string srdf_note;
+    if (!options_.srdf.empty()) {
+      srdf_note = srdf_excludes(scene, why);
+      out.notes.push_back(srdf_note);
+    }
+
+    std::string texts;
+    std::set<std::string> text_names;
+    for (const RobotPair& p : scene.self_pairs()) {
+      const auto w = why.find(key(p.geom1, p.geom2));
+      if (w == why.end()) continue;
+      UrdfExclude e;
+      e.geom1 = object_name(m, mjOBJ_GEOM, p.geom1);
+      e.geom2 = object_name(m, mjOBJ_GEOM, p.geom2);
+      e.depth = depth.count(w->first) ? depth[w->first] : 0.0;
+      for (const auto& r : w->second) e.reason += (e.reason.empty() ? "" : "; and ") + r;
+      for (const std::string* g : {&e.geom1, &e.geom2})
+        if (g->find_first_of(" \t\r\n") != std::string::npos)
+          throw InputError(file_ + ": box '" + *g + "' must be excluded from self-collision (" + e.reason +
+                           "), but a name with white space cannot be: rename its link");
+      std::string name = "leeway_exclude_" + e.geom1 + "_" + e.geom2;
+      for (int k = 2; !text_names.insert(name).second; ++k)
+        name = "leeway_exclude_" + e.geom1 + "_" + e.geom2 + "_" + std::to_string(k);
+      texts += detail::wrapped_comment(e.geom1 + " and " + e.geom2 + ": " + e.reason + ".", 4) +
+               "    <text name=\"" + xml_escape(name) + "\" data=\"" + xml_escape(e.geom1 + " " + e.geom2) +
+               "\"/>\n";
+      out.excludes.push_back(std::move(e));
+    }
+    std::ostringstream x;
+    x << "<!--\n"
+      << "  Self-collision excludes of robot '" << comment_text(out.robot_name)
+      << "' imported from the URDF '" << comment_text(fs::path(file_).filename().string())
+      << "' by leeway import-urdf (docs/robots.md).\n"
+      << "  Include this file at the top level of the cell, beside <worldbody> (an include inside the\n"
+      << "  world body cannot carry <custom>); leeway new-cell does. leeway checks every other pair of\n"
+      << "  robot boxes on parts that are neither the same nor parent and child\n"
+      << "  (docs/mjcf-conventions.md, \"Self-collision\").\n";
+    if (!srdf_note.empty()) x << "  Note: " << comment_text(srdf_note) << "\n";
+    x << "-->\n<mujoco>\n";
+    if (texts.empty())
+      // MuJoCo refuses an include without elements: an empty <custom> stands in.
+      x << "  <!-- Nothing excluded: no two boxes checked against each other touch at the reference\n"
+        << "       configuration (every joint at 0 or the limit nearest 0)"
+        << (options_.srdf.empty() ? "" : ", and the SRDF disables no such pair") << ". -->\n"
+        << "  <custom/>\n";
+    else
+      x << "  <custom>\n" << texts << "  </custom>\n";
+    x << "</mujoco>\n";
+    out.excludes_mjcf = x.str();
+
+    // The excludes read back as leeway reads them: exactly these pairs leave the check.
+    const Scene with =
+        load_cell(as_cell(out.mjcf, texts.empty() ? "" : "<custom>\n" + texts + "</custom>\n"));
+    LEEWAY_DEMAND(with.excluded_pairs().size() == out.excludes.size());
+    out.self_pairs = static_cast<int>(with.self_pairs().size());
+  }
+
+  // The SRDF's <disable_collisions> entries, as reasons for the box pairs of the two links that
+  // leeway checks; pairs it never checks (one rigid part, or parent and child) need no exclude.
+  // Returns a one-line summary.
+  std::string srdf_excludes(const Scene& scene,
+                            std::map<std::pair<int, int>, std::vector<std::string>>& why) {
+    const std::string& srdf = options_.srdf;
+    require_regular_input(srdf, "SRDF file");
+    TiXmlDocument doc;
+    if (!doc.LoadFile(srdf))
+      throw InputError(srdf + ": not a valid SRDF: " + doc.ErrorDesc() + " (line " +
+                       std::to_string(doc.ErrorRow()) + ")");
+    const TiXmlElement* root = doc.RootElement();
+    if (!root || root->ValueStr() != "robot")
+      throw InputError(srdf + ": not a valid SRDF: the root element is not <robot>");
+    const std::string name = fs::path(srdf).filename().string();
+    const mjModel& m = scene.model();
+    std::set<std::pair<int, int>> checked;
+    for (const RobotPair& p : scene.self_pairs())
+      checked.insert({std::min(p.geom1, p.geom2), std::max(p.geom1, p.geom2)});
+    int entries = 0, unchecked = 0;
+    for (const TiXmlElement* e = root->FirstChildElement("disable_collisions"); e;
+         e = e->NextSiblingElement("disable_collisions")) {
+      const char* l1 = e->Attribute("link1");
+      const char* l2 = e->Attribute("link2");
+      const char* reason = e->Attribute("reason");
+      const std::string where = srdf + ": <disable_collisions> on line " + std::to_string(e->Row());
+      if (!l1 || !l2) throw InputError(where + " needs both link1 and link2");
+      for (const char* l : {l1, l2})
+        if (!model_->getLink(l))
+          throw InputError(where + " names link '" + l + "', which the URDF '" + file_ + "' does not have");
+      ++entries;
+      bool any = false;
+      for (const Body& b1 : bodies_)
+        for (const Geom& g1 : b1.geoms)
+          for (const Body& b2 : bodies_)
+            for (const Geom& g2 : b2.geoms) {
+              if (g1.link != l1 || g2.link != l2) continue;
+              const int a = mj_name2id(&m, mjOBJ_GEOM, g1.name.c_str()),
+                        b = mj_name2id(&m, mjOBJ_GEOM, g2.name.c_str());
+              const auto k = std::make_pair(std::min(a, b), std::max(a, b));
+              if (!checked.count(k)) continue;
+              any = true;
+              const std::string r = "the SRDF '" + name + "' disables collisions between links '" + l1 +
+                                    "' and '" + l2 + "'" +
+                                    (reason ? " (reason '" + std::string(reason) + "')" : std::string());
+              if (std::find(why[k].begin(), why[k].end(), r) == why[k].end()) why[k].push_back(r);
+            }
+      if (!any) ++unchecked;
+    }
+    return "the SRDF '" + name + "' disables " + std::to_string(entries) + " link pair(s); " +
+           std::to_string(unchecked) +
+           " of them have no box pair leeway checks (one rigid part, parent and child, or no boxes)";
+  }
+
   std::string file_, urdf_dir_;
   const UrdfImportOptions& options_;
   urdf::ModelInterfaceSharedPtr model_;
@@ -607,6 +767,11 @@ std::string resolve_urdf_resource(const std::string& uri, const std::string& urd
 
 UrdfImport import_urdf(const std::string& urdf_path, const UrdfImportOptions& options) {
   return Importer(urdf_path, options).run();
+}
+
+std::string excludes_path(const std::string& robot_path) {
+  const fs::path p(robot_path);
+  return (p.parent_path() / (p.stem().string() + "_excludes" + p.extension().string())).string();
 }
 
 }  // namespace leeway

@@ -61,6 +61,45 @@ TEST_F(CheckTest, KnownCollisionInAKeyframe) {
   EXPECT_TRUE(has_problem(r, "keyframe 'left': link 'link_box' collides with obstacle 'wall'"));
 }
 
+TEST_F(CheckTest, AKeyframeFoldedIntoItselfFailsNamingBothGeoms) {
+  // j3 = pi/2 turns l3 down along l2: the tool (z 0.3 .. 0.4 m) sinks 0.1 m into l1 (z 0.2 .. 0.4 m),
+  // and l3's end meets l1's top; no obstacle is touched.
+  scene_ = std::make_unique<Scene>(Scene::load(
+      dir_.write("cell.xml", test::three_link_cell("", R"(<key name="folded" qpos="0 0 1.5707963"/>)"))));
+  const CheckReport r = check_scene(*scene_);
+  EXPECT_FALSE(r.ok());
+  ASSERT_EQ(r.keyframes.size(), 2u);
+  EXPECT_TRUE(r.keyframes[0].self_collisions.empty());
+  const KeyframeFindings& folded = r.keyframes[1];
+  EXPECT_TRUE(folded.collisions.empty());
+  ASSERT_FALSE(folded.self_collisions.empty());
+  EXPECT_EQ(scene_->geom_label(folded.self_collisions[0].geom1), "l1_box");
+  EXPECT_EQ(scene_->geom_label(folded.self_collisions[0].geom2), "tool_box");
+  EXPECT_NEAR(folded.self_collisions[0].depth, 0.1, 1e-6);
+  EXPECT_TRUE(has_problem(r,
+                          "keyframe 'folded': robot geoms 'l1_box' and 'tool_box' collide "
+                          "(self-collision, depth 0.1 m)"));
+  EXPECT_THAT(to_text(*scene_, r),
+              HasSubstr("self-collision: 5 robot geom pairs checked, 0 excluded by the cell"));
+  const nlohmann::json j = to_json(*scene_, r);
+  EXPECT_EQ(j.at("robot").at("self_pairs"), 5);
+  EXPECT_EQ(j.at("keyframes").at(1).at("self_collisions").at(0).at("a"), "l1_box");
+  EXPECT_EQ(j.at("keyframes").at(1).at("self_collisions").at(0).at("b"), "tool_box");
+
+  // Excluded, the same keyframe passes, and the report says how each pair was excluded.
+  scene_ = std::make_unique<Scene>(Scene::load(dir_.write(
+      "excluded.xml", test::three_link_cell(R"(<contact><exclude body1="link1" body2="link3"/></contact>
+  <custom><text name="leeway_exclude_tool" data="l1_box tool_box"/></custom>)",
+                                            R"(<key name="folded" qpos="0 0 1.5707963"/>)"))));
+  const CheckReport ok = check_scene(*scene_);
+  EXPECT_TRUE(ok.ok()) << ::testing::PrintToString(ok.problems);
+  const nlohmann::json e = to_json(*scene_, ok).at("robot");
+  EXPECT_EQ(e.at("self_pairs"), 3);
+  EXPECT_EQ(e.at("excluded_pairs"),
+            nlohmann::json::parse(R"([{"a": "l1_box", "b": "l3_box", "by": "body exclude"},
+                                      {"a": "l1_box", "b": "tool_box", "by": "leeway_exclude"}])"));
+}
+
 TEST_F(CheckTest, JointLimitViolation) {
   const auto r = run("", R"(<key name="over" qpos="3.1"/>)");
   ASSERT_EQ(r.keyframes[0].limit_violations.size(), 1u);

@@ -16,6 +16,7 @@
 #include "leeway/error.hpp"
 #include "leeway/kinematics.hpp"
 #include "leeway/midphase.hpp"
+#include "leeway/mujoco_util.hpp"
 #include "leeway/nominal_path.hpp"
 #include "leeway/params.hpp"
 #include "leeway/volume.hpp"
@@ -108,6 +109,48 @@ TEST(CheckerNameTest, ParsesBothAndRefusesOthers) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("'fcl' is not one of: midphase, mujoco"), std::string::npos);
   }
+}
+
+// ---------------------------------------------------------------- excludes and the fast core
+
+TEST_F(CollisionTest, ARobotBodyExcludeKeepsTheFastCore) {
+  // In a Scene the robot's geoms never touch one another by their (normalised) bitmasks: an exclude
+  // between two robot bodies only drops self pairs, and mj_collision's answer stays the midphase's.
+  test::TempDir dir;
+  const Scene s = Scene::load(dir.write(
+      "cell.xml", test::three_link_cell(R"(<contact><exclude body1="link3" body2="base"/></contact>)")));
+  const mjModel& m = s.model();
+  ASSERT_EQ(m.nexclude, 1);
+  const auto [b1, b2] = excluded_bodies(m, 0);
+  EXPECT_EQ(object_name(m, mjOBJ_BODY, b1), "base");  // sorted by body id
+  EXPECT_EQ(object_name(m, mjOBJ_BODY, b2), "link3");
+  EXPECT_FALSE(excludes_a_contact(m));
+  EXPECT_TRUE(emulates_mj_collision(m));
+  EXPECT_EQ(s.checker(), CollisionChecker::kMidphase);
+}
+
+TEST_F(CollisionTest, AnExcludeBetweenBodiesThatCouldTouchNeedsMujoco) {
+  // The same excludes on the model as written (every geom contype = conaffinity = 1, the MJCF
+  // default): the bodies could touch, so the exclude changes what mj_collision reports.
+  const std::string robot_pair = R"(<contact><exclude body1="base" body2="link3"/></contact>)";
+  const ModelPtr raw = load_model_text(test::three_link_cell(robot_pair), "raw.xml");
+  EXPECT_TRUE(excludes_a_contact(*raw));
+  EXPECT_FALSE(emulates_mj_collision(*raw));
+  // Two cell bodies: 'stand' (block: contype 0, conaffinity 1) and 'crate' (the defaults) can touch.
+  const std::string crate = R"(<contact><exclude body1="stand" body2="crate"/></contact>)";
+  std::string xml = test::three_link_cell(crate);
+  xml.replace(xml.find("  </worldbody>"), 0,
+              "    <body name=\"crate\" pos=\"-1.5 1 0\"><geom name=\"crate_box\" type=\"box\" "
+              "size=\"0.2 0.2 0.2\" pos=\"0 0 0.2\"/></body>\n");
+  const ModelPtr cell = load_model_text(xml, "crate.xml");
+  EXPECT_TRUE(excludes_a_contact(*cell));
+  EXPECT_FALSE(emulates_mj_collision(*cell));
+  // Bodies whose bitmasks cannot meet (both contype 0): the exclude removes nothing.
+  std::string apart = xml;
+  apart.replace(apart.find("size=\"0.2 0.2 0.2\""), 0, "contype=\"0\" ");
+  const ModelPtr none = load_model_text(apart, "apart.xml");
+  EXPECT_FALSE(excludes_a_contact(*none));
+  EXPECT_TRUE(emulates_mj_collision(*none));
 }
 
 // ---------------------------------------------------------------- checker parity

@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "leeway/check.hpp"
+#include "leeway/error.hpp"
 #include "leeway/scene.hpp"
 #include "test_util.hpp"
 
@@ -31,8 +32,14 @@ TEST_F(NewCellTest, AroundTheHandWrittenIrb6700) {
   fs::create_directories(dir.path() / "cells");
   fs::create_directory_symlink(std::string(LEEWAY_MJCF_DIR) + "/robots", dir.path() / "robots");
   const std::string cell = (dir.path() / "cells/irb.xml").string();
-  const NewCell c = write_new_cell((dir.path() / "robots/irb6700_body.xml").string(), cell, "irb");
+  const NewCell c = write_new_cell((dir.path() / "robots/irb6700_body.xml").string(), cell, "irb",
+                                   (dir.path() / "robots/irb6700_excludes.xml").string());
   EXPECT_EQ(c.robot_include, "../robots/irb6700_body.xml");
+  // The IRB 6700's three box overlaps are excluded by its excludes fragment, included at the top.
+  EXPECT_EQ(c.excludes_include, "../robots/irb6700_excludes.xml");
+  EXPECT_EQ(c.included_excludes, 3);
+  EXPECT_TRUE(c.cell_excludes.empty());
+  EXPECT_THAT(c.mjcf, HasSubstr("  <include file=\"../robots/irb6700_excludes.xml\"/>\n  <worldbody>"));
   EXPECT_EQ(c.joints, 6);
   EXPECT_EQ(c.home, "0 0 0 0 0 0");
   // The reach bound by hand: from joint 1 (link_1's origin) down to the patch box: body offsets
@@ -46,6 +53,64 @@ TEST_F(NewCellTest, AroundTheHandWrittenIrb6700) {
   EXPECT_EQ(s.obstacle_geoms().size(), 0u);
   EXPECT_THAT(c.mjcf, HasSubstr("<numeric name=\"leeway_reach_radius\" data=\"3.9\"/>"));
   EXPECT_EQ(files_in(dir.path() / "cells"), 1);  // no temporary file left
+}
+
+TEST_F(NewCellTest, PairsTouchingAtHomeAreExcludedInTheCellWithoutAnExcludesFragment) {
+  // irb6700_body.xml has no irb6700_body_excludes.xml beside it: the pairs that touch at home are
+  // excluded in the cell itself, each with its overlap in a comment. At home that is the elbow (the
+  // upper arm's and the forearm tube's boxes overlap by 5 cm at every j3) and the wrist's box
+  // against the flange's.
+  test::TempDir dir;
+  fs::create_directories(dir.path() / "cells");
+  fs::create_directory_symlink(std::string(LEEWAY_MJCF_DIR) + "/robots", dir.path() / "robots");
+  const std::string cell = (dir.path() / "cells/irb.xml").string();
+  const NewCell c = write_new_cell((dir.path() / "robots/irb6700_body.xml").string(), cell, "irb");
+  EXPECT_TRUE(c.excludes_include.empty());
+  EXPECT_EQ(c.included_excludes, 0);
+  ASSERT_FALSE(c.cell_excludes.empty());
+  EXPECT_EQ(c.cell_excludes[0].geom1, "link_2_box");
+  EXPECT_EQ(c.cell_excludes[0].geom2, "link_4_tube_box");
+  EXPECT_NEAR(c.cell_excludes[0].depth, 0.05, 0.01);
+  EXPECT_THAT(c.cell_excludes[0].reason, HasSubstr("at keyframe home"));
+  EXPECT_THAT(c.mjcf,
+              AllOf(HasSubstr("<!-- link_2_box and link_4_tube_box: the geoms overlap by 0.0"),
+                    HasSubstr("<text name=\"leeway_exclude_home_1\" data=\"link_2_box link_4_tube_box\"/>")));
+  const Scene s = Scene::load(cell);
+  EXPECT_EQ(s.excluded_pairs().size(), c.cell_excludes.size());
+  EXPECT_EQ(static_cast<int>(s.self_pairs().size()), c.self_pairs);
+  EXPECT_TRUE(check_scene(s).ok());
+}
+
+TEST_F(NewCellTest, TheExcludesBesideTheRobotAreIncluded) {
+  // robot.xml and robot_excludes.xml side by side, as import-urdf writes them; the fragment excludes
+  // the mast on the base against the outer link (a pair chosen for the test).
+  test::TempDir dir;
+  const std::string robot = dir.write("robot.xml", R"(<mujoco>
+  <body name="base"><geom name="base_box" type="box" size="0.1 0.1 0.25" pos="0 0 0.25" contype="1" conaffinity="0"/>
+    <geom name="mast_box" type="box" size="0.05 0.05 0.5" pos="0.5 0 0.5" contype="1" conaffinity="0"/>
+    <body name="link" pos="0 0 0.5">
+      <joint name="j1" type="hinge" axis="0 0 1" range="-3 3" user="1"/>
+      <geom name="link_box" type="box" size="0.5 0.05 0.05" pos="0.5 0 0" contype="1" conaffinity="0"/>
+      <body name="link2" pos="1 0 0">
+        <joint name="j2" type="hinge" axis="0 0 1" range="-3 3" user="1"/>
+        <geom name="link2_box" type="box" size="0.3 0.05 0.05" pos="0.3 0 0" contype="1" conaffinity="0"/>
+        <site name="tool0" pos="0.6 0 0"/>
+      </body>
+    </body>
+  </body>
+</mujoco>)");
+  // The rule checks base_box and mast_box against link2_box (link_box is the base's child).
+  dir.write("robot_excludes.xml", R"(<mujoco><custom>
+  <text name="leeway_exclude_a" data="mast_box link2_box"/></custom></mujoco>)");
+  const NewCell c = write_new_cell(robot, (dir.path() / "cell.xml").string(), "two");
+  EXPECT_EQ(c.excludes_include, "robot_excludes.xml");
+  EXPECT_EQ(c.included_excludes, 1);
+  EXPECT_EQ(c.self_pairs, 1);  // base_box - link2_box
+  EXPECT_TRUE(c.cell_excludes.empty());
+  // A named excludes file that is missing is an error.
+  EXPECT_THROW(
+      write_new_cell(robot, (dir.path() / "c2.xml").string(), "two", (dir.path() / "no.xml").string()),
+      InputError);
 }
 
 TEST_F(NewCellTest, HomeIsTheValueNearestZeroWithinTheLimits) {

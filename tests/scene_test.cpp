@@ -3,6 +3,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include "leeway/error.hpp"
 #include "test_util.hpp"
 
@@ -166,6 +168,68 @@ TEST(ParseVectorTest, RejectsNonNumbersNanAndInf) {
       EXPECT_THAT(e.what(), HasSubstr("--q: value"));
     }
   }
+}
+
+// The self pairs of a Scene by geom name, each "a|b" with a on the part nearer the root.
+template <typename Pairs>
+std::set<std::string> pair_names(const Scene& s, const Pairs& pairs) {
+  std::set<std::string> out;
+  for (const auto& p : pairs) out.insert(s.geom_label(p.geom1) + "|" + s.geom_label(p.geom2));
+  return out;
+}
+
+TEST_F(SceneTest, SelfPairsAreTheRigidPartsNeitherTheSameNorParentAndChild) {
+  // Parts (MuJoCo's weld bodies): the world with base_box, link1, link2, and link3 with the tool
+  // welded to it. Of the 10 pairs of the 5 robot geoms, l3_box|tool_box share a part and
+  // base_box|l1_box, l1_box|l2_box, l2_box|l3_box, l2_box|tool_box are parent and child: 5 remain.
+  const Scene s = Scene::load(dir_.write("cell.xml", test::three_link_cell()));
+  EXPECT_EQ(pair_names(s, s.self_pairs()),
+            (std::set<std::string>{"base_box|l2_box", "base_box|l3_box", "base_box|tool_box", "l1_box|l3_box",
+                                   "l1_box|tool_box"}));
+  EXPECT_TRUE(s.excluded_pairs().empty());
+  // The base touches links only through self pairs: it is no link and no obstacle.
+  EXPECT_EQ(s.base_geoms().size(), 1u);
+  EXPECT_EQ(s.link_geoms().size(), 4u);
+}
+
+TEST_F(SceneTest, ABodyExcludeRemovesThatBodysPairsAndAGeomExcludeOnePair) {
+  // MuJoCo's body exclude between base and link3: base_box|l3_box only (the tool is another body,
+  // though welded to link3); the geom exclude drops l1_box|tool_box only.
+  const Scene s = Scene::load(
+      dir_.write("cell.xml", test::three_link_cell(R"(<contact><exclude body1="base" body2="link3"/></contact>
+  <custom><text name="leeway_exclude_tool" data="tool_box l1_box"/></custom>)")));
+  EXPECT_EQ(pair_names(s, s.self_pairs()),
+            (std::set<std::string>{"base_box|l2_box", "base_box|tool_box", "l1_box|l3_box"}));
+  ASSERT_EQ(s.excluded_pairs().size(), 2u);
+  for (const ExcludedPair& e : s.excluded_pairs()) {
+    const std::string name = s.geom_label(e.geom1) + "|" + s.geom_label(e.geom2);
+    if (name == "base_box|l3_box")
+      EXPECT_TRUE(e.by_body);
+    else if (name == "l1_box|tool_box")
+      EXPECT_FALSE(e.by_body);
+    else
+      ADD_FAILURE() << "excluded " << name;
+  }
+  // Excluding a pair the rule never checks (parent and child) changes nothing.
+  const Scene t = Scene::load(dir_.write(
+      "adjacent.xml", test::three_link_cell(R"(<contact><exclude body1="link1" body2="link2"/></contact>)")));
+  EXPECT_EQ(t.self_pairs().size(), 5u);
+  EXPECT_TRUE(t.excluded_pairs().empty());
+}
+
+TEST_F(SceneTest, ExcludesThatCannotBeUsedAreRefused) {
+  expect_error(test::three_link_cell(R"(<contact><exclude body1="link3" body2="stand"/></contact>)"),
+               {"<exclude body1='link3' body2='stand'> pairs a robot body with a body of the cell"});
+  expect_error(
+      test::three_link_cell(R"(<custom><text name="leeway_exclude_x" data="l1_box l9_box"/></custom>)"),
+      {"custom text 'leeway_exclude_x' names geom 'l9_box', which does not exist"});
+  expect_error(
+      test::three_link_cell(R"(<custom><text name="leeway_exclude_x" data="l1_box block"/></custom>)"),
+      {"names geom 'block', which is not a collidable robot geom"});
+  expect_error(test::three_link_cell(R"(<custom><text name="leeway_exclude_x" data="l1_box"/></custom>)"),
+               {"custom text 'leeway_exclude_x' must name two robot geoms, not 1 words"});
+  expect_error(test::three_link_cell(R"(<contact><exclude body1="link1" body2="ghost"/></contact>)"),
+               {"MJCF does not compile", "body 'ghost' not found"});
 }
 
 TEST_F(SceneTest, ValidateConfigurationNamesJointAndValue) {

@@ -141,4 +141,47 @@ inline std::string one_link_cell(const std::string& world, const std::string& ke
 )";
 }
 
+//! A three-link arm for the self-collision rule (as tests/bad_input/cells/self_collide.xml): a fixed
+//! base (base_box), hinges j1 about z at (0, 0, 0.2) (l1_box), j2 about y at 0.4 m (l2_box, 0.6 m up)
+//! and j3 about y at 1.0 m (l3_box, 0.6 m along +x at zero), a body 'tool' welded to link3 (tool_box,
+//! tool0 at its tip) and the obstacle 'block' on body 'stand'. `top` goes beside <worldbody>
+//! (<contact>, <custom>); `keys` into <keyframe>. At j3 = pi/2 l3 and the tool fold down into l1.
+inline std::string three_link_cell(const std::string& top = "", const std::string& keys = "") {
+  return R"(<mujoco model="three-link">
+  <compiler angle="radian" autolimits="true"/>
+)" + top +
+         R"(
+  <worldbody>
+    <body name="base">
+      <geom name="base_box" type="box" size="0.2 0.2 0.1" pos="0 0 0.1"/>
+      <body name="link1" pos="0 0 0.2">
+        <joint name="j1" type="hinge" axis="0 0 1" range="-3 3" user="1.5"/>
+        <geom name="l1_box" type="box" size="0.1 0.1 0.1" pos="0 0 0.1"/>
+        <body name="link2" pos="0 0 0.2">
+          <joint name="j2" type="hinge" axis="0 1 0" range="-2 2" user="1.5"/>
+          <geom name="l2_box" type="box" size="0.05 0.05 0.3" pos="0 0 0.3"/>
+          <body name="link3" pos="0 0 0.6">
+            <joint name="j3" type="hinge" axis="0 1 0" range="-3 3" user="1.5"/>
+            <geom name="l3_box" type="box" size="0.3 0.04 0.04" pos="0.3 0 0"/>
+            <body name="tool" pos="0.6 0 0">
+              <geom name="tool_box" type="box" size="0.05 0.05 0.05" pos="0.05 0 0"/>
+              <site name="tool0" pos="0.1 0 0"/>
+            </body>
+          </body>
+        </body>
+      </body>
+    </body>
+    <body name="stand" pos="-1.5 0 0">
+      <geom name="block" type="box" pos="0 0 0.5" size="0.1 0.1 0.5" contype="0" conaffinity="1"/>
+    </body>
+  </worldbody>
+  <keyframe>
+    <key name="a" qpos="0 0 0"/>
+)" + keys +
+         R"(
+  </keyframe>
+</mujoco>
+)";
+}
+
 }  // namespace leeway::test

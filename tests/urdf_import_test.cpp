@@ -12,6 +12,7 @@
 #include <random>
 
 #include "leeway/box.hpp"
+#include "leeway/check.hpp"
 #include "leeway/kinematics.hpp"
 #include "leeway/scene.hpp"
 #include "stl_util.hpp"
@@ -469,9 +470,17 @@ TEST(UrdfImportCliTest, SevenJointArmEndToEnd) {
   EXPECT_THAT(imp.out, HasSubstr("7 joints (a1, a2, a3, a4, a5, a6, a7), 8 collision boxes"));
   EXPECT_THAT(imp.out,
               HasSubstr("note: the root link 'world' and its fixed joint 'world-base' are left out"));
+  // The boxes of the upper arm and the forearm meet face to face at the elbow (a3 and a4 share their
+  // origin), those of the forearm and link_6 at the wrist: both pairs are excluded, and said so.
+  EXPECT_THAT(imp.out, HasSubstr("wrote " + (dir.path() / "robots/arm7_excludes.xml").string() +
+                                 ": 2 box pair(s) excluded from self-collision, 19 checked"));
+  EXPECT_THAT(imp.out, HasSubstr("excluded: 'link_2_box' and 'link_4_box': the boxes touch (within 1e-06 m) "
+                                 "at the reference configuration"));
+  EXPECT_THAT(imp.out, HasSubstr("excluded: 'link_4_box' and 'link_6_box': the boxes touch"));
   const auto nc = test::run_cli("new-cell --robot " + quoted(robot) + " --out " + quoted(cell));
   ASSERT_EQ(nc.exit_code, 0) << nc.out;
-  EXPECT_THAT(nc.out, HasSubstr("includes ../robots/arm7.xml, 7 joints, keyframe home = [0 0 0 0 0 0 0]"));
+  EXPECT_THAT(nc.out, HasSubstr("includes ../robots/arm7.xml and ../robots/arm7_excludes.xml, 7 joints, "
+                                "keyframe home = [0 0 0 0 0 0 0]"));
   ASSERT_EQ(test::run_cli("check " + quoted(cell)).exit_code, 0);
 
   // Obstacles and a second keyframe, as a user would add them: a table in front of the arm and a
@@ -548,6 +557,175 @@ TEST(UrdfImportCliTest, FourJointArmPlansAndBounds) {
       test::run_cli("cf " + quoted(cell) + " " + quoted(bounds) + " --samples 2000 --threads 1 --json");
   ASSERT_EQ(cf.exit_code, 0) << cf.out;
   EXPECT_EQ(nlohmann::json::parse(cf.out).at("cf").get<double>(), 1.0);
+}
+
+// Three joints whose reference configuration (j1 at its lower limit 0.5 rad, j2 and j3 at 0) has
+// link_3's box, which reaches back from the elbow over the column, 0.05 m deep in link_1's box.
+const std::string kOverlapping = R"(<robot name="overlap">
+  <link name="base_link"><collision><origin xyz="0 0 0.1"/><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
+  <link name="link_1"><collision><origin xyz="0 0 0.25"/><geometry><box size="0.1 0.1 0.5"/></geometry></collision></link>
+  <link name="link_2"><collision><origin xyz="0.1 0 0"/><geometry><box size="0.2 0.1 0.1"/></geometry></collision></link>
+  <link name="link_3"><collision><origin xyz="-0.1 0 0"/><geometry><box size="0.3 0.1 0.1"/></geometry></collision></link>
+  <link name="tool0"/>
+  <joint name="j1" type="revolute"><origin xyz="0 0 0.2"/><parent link="base_link"/><child link="link_1"/>
+    <axis xyz="0 0 1"/><limit lower="0.5" upper="3" effort="1" velocity="2"/></joint>
+  <joint name="j2" type="revolute"><origin xyz="0 0 0.5"/><parent link="link_1"/><child link="link_2"/>
+    <axis xyz="0 1 0"/><limit lower="-2" upper="2" effort="1" velocity="2"/></joint>
+  <joint name="j3" type="revolute"><origin xyz="0.2 0 0"/><parent link="link_2"/><child link="link_3"/>
+    <axis xyz="0 1 0"/><limit lower="-2" upper="2" effort="1" velocity="2"/></joint>
+  <joint name="j3-tool0" type="fixed"><origin xyz="0.05 0 0"/><parent link="link_3"/><child link="tool0"/></joint>
+</robot>
+)";
+
+// `fragment` and `excludes` as dir/robots/NAME.xml and NAME_excludes.xml, and a cell dir/cells/NAME.xml
+// including both (the excludes at the top level), with keyframe home at the reference configuration;
+// returns the cell.
+std::string cell_with_excludes(const test::TempDir& dir, const std::string& name, const UrdfImport& robot) {
+  fs::create_directories(dir.path() / "robots");
+  fs::create_directories(dir.path() / "cells");
+  dir.write("robots/" + name + ".xml", robot.mjcf);
+  dir.write("robots/" + name + "_excludes.xml", robot.excludes_mjcf);
+  const std::string robots = "../robots/" + name;
+  std::string xml = "<mujoco model=\"" + name + "\"><compiler angle=\"radian\" autolimits=\"true\"/>";
+  xml += "<include file=\"" + robots + "_excludes.xml\"/>";
+  xml += "<worldbody><include file=\"" + robots + ".xml\"/></worldbody>";
+  xml += "<keyframe><key name=\"home\" qpos=\"" + robot.reference + "\"/></keyframe></mujoco>\n";
+  return dir.write("cells/" + name + ".xml", xml);
+}
+
+TEST_F(UrdfImportTest, ExcludesTheBoxesThatOverlapAtTheReferenceConfiguration) {
+  test::TempDir dir;
+  const UrdfImport robot = import_urdf(dir.write("overlap.urdf", kOverlapping));
+  EXPECT_EQ(robot.reference, "0.5 0 0");
+  // Four boxes on a chain of four parts: 6 pairs, 3 of them parent and child; 1 excluded.
+  ASSERT_EQ(robot.excludes.size(), 1u);
+  const UrdfExclude& e = robot.excludes[0];
+  EXPECT_EQ(e.geom1, "link_1_box");
+  EXPECT_EQ(e.geom2, "link_3_box");
+  EXPECT_NEAR(e.depth, 0.05, 1e-9);
+  EXPECT_THAT(e.reason, AllOf(HasSubstr("the boxes overlap by 0.05 m at the reference configuration"),
+                              HasSubstr("an artefact of the box approximation; check it")));
+  EXPECT_EQ(robot.self_pairs, 2);
+  EXPECT_THAT(
+      robot.excludes_mjcf,
+      AllOf(HasSubstr("<!-- link_1_box and link_3_box: the boxes overlap by 0.05 m"),
+            HasSubstr("<text name=\"leeway_exclude_link_1_box_link_3_box\" data=\"link_1_box link_3_box\"/>"),
+            HasSubstr("at the top level of the cell")));
+  // Included at a cell's top level, the exclude is leeway's: the reference configuration passes.
+  const Scene s = Scene::load(cell_with_excludes(dir, "overlap", robot));
+  EXPECT_EQ(s.self_pairs().size(), 2u);
+  ASSERT_EQ(s.excluded_pairs().size(), 1u);
+  EXPECT_FALSE(s.excluded_pairs()[0].by_body);
+  EXPECT_EQ(s.geom_label(s.excluded_pairs()[0].geom1), "link_1_box");
+  EXPECT_TRUE(check_scene(s).ok());
+
+  // Nothing to exclude: the fragment still compiles as an include (MuJoCo refuses an empty one).
+  const UrdfImport clean = import_urdf(dir.write("two.urdf", kTwoJoints));
+  EXPECT_TRUE(clean.excludes.empty());
+  EXPECT_THAT(clean.excludes_mjcf, HasSubstr("Nothing excluded"));
+  EXPECT_EQ(Scene::load(cell_with_excludes(dir, "two", clean)).excluded_pairs().size(), 0u);
+}
+
+TEST_F(UrdfImportTest, SrdfDisabledPairsAreExcludedWithTheirReason) {
+  test::TempDir dir;
+  const std::string urdf = dir.write("overlap.urdf", kOverlapping);
+  UrdfImportOptions options;
+  options.srdf = dir.write("overlap.srdf", R"(<?xml version="1.0"?>
+<robot name="overlap">
+  <group name="arm"><chain base_link="base_link" tip_link="tool0"/></group>
+  <disable_collisions link1="base_link" link2="link_1" reason="Adjacent"/>
+  <disable_collisions link1="base_link" link2="link_2" reason="Never"/>
+  <disable_collisions link1="link_3" link2="link_1" reason="Never"/>
+</robot>
+)");
+  const UrdfImport robot = import_urdf(urdf, options);
+  ASSERT_EQ(robot.excludes.size(), 2u);
+  EXPECT_EQ(robot.excludes[0].geom1, "base_link_box");
+  EXPECT_EQ(robot.excludes[0].geom2, "link_2_box");
+  EXPECT_EQ(robot.excludes[0].depth, 0);
+  EXPECT_EQ(
+      robot.excludes[0].reason,
+      "the SRDF 'overlap.srdf' disables collisions between links 'base_link' and 'link_2' (reason 'Never')");
+  // Overlapping and disabled: both reasons.
+  EXPECT_EQ(robot.excludes[1].geom1, "link_1_box");
+  EXPECT_THAT(robot.excludes[1].reason,
+              AllOf(HasSubstr("the boxes overlap by 0.05 m"),
+                    HasSubstr("; and the SRDF 'overlap.srdf' disables collisions between links 'link_3' and "
+                              "'link_1' (reason 'Never')")));
+  EXPECT_EQ(robot.self_pairs, 1);
+  ASSERT_EQ(robot.notes.size(), 1u);
+  EXPECT_EQ(robot.notes[0],
+            "the SRDF 'overlap.srdf' disables 3 link pair(s); 1 of them have no box pair leeway checks "
+            "(one rigid part, parent and child, or no boxes)");
+
+  // An SRDF naming a link the URDF lacks, a malformed one and a missing one are refused.
+  const std::pair<std::string, std::string> bad[] = {
+      {"<robot><disable_collisions link1=\"link_1\" link2=\"hand\" reason=\"Never\"/></robot>",
+       "<disable_collisions> on line 1 names link 'hand', which the URDF '" + urdf + "' does not have"},
+      {"<robot><disable_collisions link1=\"link_1\"/></robot>", "needs both link1 and link2"},
+      {"<robot><disable_collisions", "not a valid SRDF"},
+      {"<srdf/>", "not a valid SRDF: the root element is not <robot>"},
+  };
+  for (const auto& [text, message] : bad) {
+    options.srdf = dir.write("bad.srdf", text);
+    try {
+      import_urdf(urdf, options);
+      ADD_FAILURE() << text;
+    } catch (const InputError& e) {
+      EXPECT_THAT(e.what(), AllOf(HasSubstr(options.srdf + ": "), HasSubstr(message)));
+    }
+  }
+  options.srdf = (dir.path() / "absent.srdf").string();
+  EXPECT_THROW(import_urdf(urdf, options), InputError);
+}
+
+TEST(UrdfImportCliTest, ImportAndNewCellWriteAndPrintTheExcludes) {
+  test::TempDir dir;
+  const std::string urdf = dir.write("overlap.urdf", kOverlapping);
+  const std::string srdf = dir.write(
+      "overlap.srdf",
+      R"(<robot name="overlap"><disable_collisions link1="base_link" link2="link_2" reason="Never"/></robot>)");
+  fs::create_directories(dir.path() / "robots");
+  fs::create_directories(dir.path() / "cells");
+  const fs::path robot = dir.path() / "robots/overlap.xml", cell = dir.path() / "cells/overlap.xml";
+  const auto imp = test::run_cli("import-urdf " + urdf + " --out " + quoted(robot) + " --srdf " + srdf);
+  ASSERT_EQ(imp.exit_code, 0) << imp.out;
+  EXPECT_THAT(imp.out,
+              AllOf(HasSubstr("wrote " + (dir.path() / "robots/overlap_excludes.xml").string() +
+                              ": 2 box pair(s) excluded from self-collision, 1 checked"),
+                    HasSubstr("excluded: 'base_link_box' and 'link_2_box': the SRDF 'overlap.srdf' disables"),
+                    HasSubstr("excluded: 'link_1_box' and 'link_3_box': the boxes overlap by 0.05 m")));
+  const auto nc = test::run_cli("new-cell --robot " + quoted(robot) + " --out " + quoted(cell));
+  ASSERT_EQ(nc.exit_code, 0) << nc.out;
+  EXPECT_THAT(nc.out,
+              AllOf(HasSubstr("includes ../robots/overlap.xml and ../robots/overlap_excludes.xml, 3 joints, "
+                              "keyframe home = [0.5 0 0]"),
+                    HasSubstr("self-collision: 1 robot geom pairs checked, 2 excluded (2 by "
+                              "../robots/overlap_excludes.xml, 0 in the cell)")));
+  const auto check = test::run_cli("check --json " + quoted(cell));
+  ASSERT_EQ(check.exit_code, 0) << check.out;
+  EXPECT_EQ(nlohmann::json::parse(check.out).at("robot").at("excluded_pairs").size(), 2u);
+}
+
+// The bundled robot mjcf/robots/wide_elbow.xml (and its excludes) is what import-urdf writes from
+// tests/data/urdf/wide_elbow.urdf; its cell passes the check (workcells_test.cpp).
+TEST_F(UrdfImportTest, TheBundledWideElbowRobotIsTheImportOfItsUrdf) {
+  const UrdfImport robot = import_urdf(kUrdfDir + "/wide_elbow.urdf");
+  auto read = [](const std::string& path) {
+    std::ifstream in(path);
+    return std::string((std::istreambuf_iterator<char>(in)), {});
+  };
+  EXPECT_EQ(robot.mjcf, read(std::string(LEEWAY_MJCF_DIR) + "/robots/wide_elbow.xml"));
+  EXPECT_EQ(robot.excludes_mjcf, read(std::string(LEEWAY_MJCF_DIR) + "/robots/wide_elbow_excludes.xml"));
+  EXPECT_EQ(robot.joints.size(), 6u);
+  EXPECT_EQ(robot.boxes, 9);
+  // 9 boxes on 7 parts (the forearm's two, link_6's flange and gripper): 36 pairs, 2 within one
+  // part and 9 parent and child; none touches at zero.
+  EXPECT_TRUE(robot.excludes.empty());
+  EXPECT_EQ(robot.self_pairs, 25);
+  const Scene s = Scene::load(test::workcell("wide_elbow"));
+  EXPECT_DOUBLE_EQ(s.joints()[2].lower, -3.14);
+  EXPECT_DOUBLE_EQ(s.joints()[2].upper, 4.61);
 }
 
 // A joint loop is refused, and the refused model does not leak: urdfdom's links own their children

@@ -30,7 +30,8 @@ struct BundledCell {
   std::vector<GoalKey> goals;
 };
 
-//! The three thesis cells and the three cells not used for tuning (docs/workcells.md).
+//! The three thesis cells, the cells not used for tuning and the imported wide-elbow arm
+//! (docs/workcells.md).
 std::vector<BundledCell> bundled_cells() {
   return {
       {"dallara", {{"patch", "patch", "patch_table"}, {"mould", "mould", "mould_table"}}},
@@ -39,6 +40,7 @@ std::vector<BundledCell> bundled_cells() {
       {"press_shop", {{"pick", "pick", "conveyor"}, {"place", "place", "press_bed"}}},
       {"rail_hall", {{"patch", "patch", "trolley"}, {"mould", "mould", "mould"}}},
       {"shelf_bay", {{"pick", "pick", "table_low"}, {"place", "place", "table_high"}}},
+      {"wide_elbow", {{"pick", "pick", "table"}, {"place", "place", "table"}}},
   };
 }
 

@@ -116,6 +116,12 @@ struct IkResult {
   int solutions_found = 0;         //!< distinct converged starts
 };
 
+//! The self pairs that touch at q, for deciding what to exclude (import-urdf, new-cell): the pairs
+//! of state.self_contacts(q), and the box pairs whose exact distance is at most `tolerance` [m],
+//! with depth 0 (boxes meeting face to face at a joint touch or not by rounding; this answers the
+//! same either way). Deepest first.
+std::vector<SelfContact> self_contacts_within(RobotState& state, const Eigen::VectorXd& q, double tolerance);
+
 //! The IK seed when the caller has none (check_scene's reach test, resolve_endpoints and
 //! site_position): the cell's first keyframe, which by convention is its home pose, or, in a cell
 //! without keyframes, the joint values nearest zero within the limits (the robot's zero pose).

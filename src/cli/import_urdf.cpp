@@ -27,17 +27,24 @@ CLI::App* add_import_urdf(CLI::App& app, ImportUrdfArgs& args) {
                   "The robot's fixed base link (default: the URDF's root link)");
   sub->add_flag("--continuous-full-turn", args.continuous_full_turn,
                 "Import continuous joints with the range -2 pi .. 2 pi rad (default: refuse them)");
+  sub->add_option("--srdf", args.srdf,
+                  "An SRDF file (MoveIt): its <disable_collisions> link pairs are excluded from\n"
+                  "self-collision too");
   return sub;
 }
 
 int run_import_urdf(const ImportUrdfArgs& args) {
-  require_output(args.out, "--out", {}, {args.urdf});
+  require_output(args.out, "--out", {}, {args.urdf, args.srdf});
+  // The excludes fragment goes beside the robot fragment, where new-cell looks for it.
+  const std::string excludes = excludes_path(args.out);
+  require_output(excludes, "--out (its excludes fragment)", {}, {args.urdf, args.srdf});
   UrdfImportOptions options;
   options.package_paths = args.package_paths;
   if (const char* env = std::getenv("ROS_PACKAGE_PATH")) options.ros_package_path = env;
   options.tool_link = args.tool;
   options.base_link = args.base_link;
   options.continuous_full_turn = args.continuous_full_turn;
+  options.srdf = args.srdf;
   UrdfImport robot;
   try {
     robot = import_urdf(args.urdf, options);
@@ -49,11 +56,17 @@ int run_import_urdf(const ImportUrdfArgs& args) {
                                                          : "--base-link LINK";
     throw InputError(std::string(e.what()) + " (see " + flag + ")");
   }
+  write_file_atomic(excludes, robot.excludes_mjcf);
   write_file_atomic(args.out, robot.mjcf);
   std::cout << "wrote " << args.out << ": robot '" << robot.robot_name << "', " << robot.joints.size()
             << " joints (";
   for (size_t i = 0; i < robot.joints.size(); ++i) std::cout << (i ? ", " : "") << robot.joints[i];
   std::cout << "), " << robot.boxes << " collision boxes\n";
+  std::cout << "wrote " << excludes << ": " << robot.excludes.size()
+            << " box pair(s) excluded from self-collision, " << robot.self_pairs
+            << " checked (include it at the top level of the cell; new-cell does)\n";
+  for (const auto& e : robot.excludes)
+    std::cout << "excluded: '" << e.geom1 << "' and '" << e.geom2 << "': " << e.reason << "\n";
   for (const auto& n : robot.notes) std::cout << "note: " << n << "\n";
   return kExitOk;
 }

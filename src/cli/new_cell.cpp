@@ -19,16 +19,28 @@ CLI::App* add_new_cell(CLI::App& app, NewCellArgs& args) {
       ->required();
   sub->add_option("--name", args.name,
                   "The cell's model name (default: the file name without its extension)");
+  sub->add_option("--excludes", args.excludes,
+                  "The robot's self-collision excludes fragment, included at the cell's top level\n"
+                  "(default: ROBOT_excludes.xml beside the robot file, when it exists)");
   return sub;
 }
 
 int run_new_cell(const NewCellArgs& args) {
-  require_output(args.out, "--out", {}, {args.robot});
+  require_output(args.out, "--out", {}, {args.robot, args.excludes});
   const std::string name = args.name.empty() ? std::filesystem::path(args.out).stem().string() : args.name;
-  const NewCell cell = write_new_cell(args.robot, args.out, name);
-  std::cout << "wrote " << args.out << ": includes " << cell.robot_include << ", " << cell.joints
+  const NewCell cell = write_new_cell(args.robot, args.out, name, args.excludes);
+  std::cout << "wrote " << args.out << ": includes " << cell.robot_include
+            << (cell.excludes_include.empty() ? "" : " and " + cell.excludes_include) << ", " << cell.joints
             << " joints, keyframe home = [" << cell.home << "] (rad or m), leeway_reach_radius "
             << cell.reach_radius << " m; leeway check: ok\n";
+  std::cout << "self-collision: " << cell.self_pairs << " robot geom pairs checked, "
+            << cell.included_excludes + static_cast<int>(cell.cell_excludes.size()) << " excluded ("
+            << cell.included_excludes << " by "
+            << (cell.excludes_include.empty() ? std::string("an excludes fragment: none")
+                                              : cell.excludes_include)
+            << ", " << cell.cell_excludes.size() << " in the cell)\n";
+  for (const auto& e : cell.cell_excludes)
+    std::cout << "excluded in the cell: '" << e.geom1 << "' and '" << e.geom2 << "': " << e.reason << "\n";
   return kExitOk;
 }
 

@@ -8,9 +8,10 @@ namespace leeway::cli {
 
 //! The command line of `leeway new-cell`.
 struct NewCellArgs {
-  std::string robot;  //!< the robot fragment (e.g. from import-urdf)
-  std::string out;    //!< the cell to write
-  std::string name;   //!< the cell's model name (default: the file name without .xml)
+  std::string robot;     //!< the robot fragment (e.g. from import-urdf)
+  std::string out;       //!< the cell to write
+  std::string name;      //!< the cell's model name (default: the file name without .xml)
+  std::string excludes;  //!< the robot's excludes fragment (default: ROBOT_excludes.xml beside it, if any)
 };
 
 //! Adds the `new-cell` subcommand, parsing into `args`; returns it.

@@ -126,6 +126,10 @@ def main():
     safety = ROOT / "docs" / "data" / "safety" / "section.md"
     if safety.exists():
         o.append(safety.read_text())
+    # Self-collision certified, against the build before it: tools/self_collision_compare.py writes this.
+    self_collision = ROOT / "docs" / "data" / "safety" / "self_collision.md"
+    if self_collision.exists():
+        o.append(self_collision.read_text())
     # The fast collision core's benchmark: tools/make_perf_results.py writes this section.
     perf = ROOT / "docs" / "data" / "perf" / "section.md"
     if perf.exists():

@@ -191,9 +191,10 @@ int run_bounds(const BoundsArgs& args) {
         {"from", args.from},
         {"to", args.to},
         {"waypoints", path.size()},
-        {"obstacle", hit.obstacle_geom >= 0 ? json(hit.obstacle) : json(nullptr)},
+        {"obstacle", hit.obstacle_geom >= 0 && !hit.self ? json(hit.obstacle) : json(nullptr)},
         {"link", hit.link_geom >= 0 ? json(hit.link) : json(nullptr)},
         {"self", hit.self},
+        {"self_with", hit.self ? json(hit.obstacle) : json(nullptr)},
         {"s", hit.path_fraction},
         {"depth", hit.depth},
         {"q", to_array(hit.q)},
@@ -206,7 +207,8 @@ int run_bounds(const BoundsArgs& args) {
           {"slide_resolution", around.slide_resolution},
           {"waypoints", planned.waypoints.size()}}}};
     path = planned.waypoints;
-    label += " (planned around '" + hit.obstacle + "')";
+    label += hit.self ? " (planned around a self-collision of '" + hit.obstacle + "' and '" + hit.link + "')"
+                      : " (planned around '" + hit.obstacle + "')";
     checked = check_path(scene, path, check);
   }
   if (!checked.free()) {

@@ -509,8 +509,8 @@ TEST_P(CertifyPropertyTest, GrownSlabsOfCertifiedBoxesAreFree) {
 }
 
 INSTANTIATE_TEST_SUITE_P(CertifyCells, CertifyPropertyTest,
-                         ::testing::Values("dallara", "baltico", "dlr", "rail_hall", "one_link", "hammer",
-                                           "telescope", "folding_hand"));
+                         ::testing::Values("dallara", "baltico", "dlr", "rail_hall", "wide_elbow", "one_link",
+                                           "hammer", "telescope", "folding_hand"));
 
 class CertifyTest : public test::MujocoTest {};
 

@@ -107,7 +107,7 @@ def main():
                  f"{sum(r['new_obstacle'] for r in rows)}, {sum(r['new_self'] for r in rows)} | |")
     lines.append("")
     lines.append(f"Samples per path: {rows[0]['samples']:,} (30 windows, seed 1). Command: "
-                 f"`tools/self_collision_compare.py --base {a.base} --samples {a.samples} --repeats {a.repeats}`.")
+                 f"`tools/self_collision_compare.py --base BASE/build/leeway --samples {a.samples} --repeats {a.repeats}`.")
     text = "\n".join(head + lines) + "\n"
     print(text)
     if a.out:

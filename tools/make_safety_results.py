@@ -76,6 +76,7 @@ def run(leeway, cell, src, dst, extra, repeats, samples, tmp):
         "ms_guide": statistics.median(t["total"] - t.get("safety", 0.0) for t in times),
         "cf": cf["cf"],
         "collisions": cf["collisions"],
+        "self_collisions": cf.get("self_collisions", 0),
         "samples": cf["samples"],
         "worst_window_cf": cf["worst_window"]["cf"],
         "width_bisected": bis,
@@ -102,17 +103,18 @@ def render(info, results):
          "`--safety certified`. *width* = mean width of the j1-j3 intervals over the waypoints [rad]; *all* "
          "= of every joint [rad, m]; *shrunk* = intervals (waypoint x joint) the safety stage narrowed; "
          "*ratio* = leeway's j1-j3 width over the guide's, the issue's target being >= 70 % where the guide's "
-         "CF is >= 99.9 %. Time in ms: the whole run (categorise, volume, bounds, safety), with the safety "
+         "CF is >= 99.9 %. *self* = samples of the same `leeway cf` in which two robot geoms touch (counted "
+         "apart; the CF counts obstacles, as the thesis's). Time in ms: the whole run (categorise, volume, bounds, safety), with the safety "
          "stage's share. Raw numbers: `docs/data/safety/results.json`.\n",
          "| path | thesis: boxes | ms | CF [%] | width | guide: CF [%] | width | leeway: boxes | ms (safety) | "
-         "CF [%] | collisions | width | all | shrunk | certified | ratio |",
-         "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|"]
+         "CF [%] | collisions | self | width | all | shrunk | certified | ratio |",
+         "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|"]
     groups = [("The nine thesis paths", THESIS_PATHS), ("Cells nothing was tuned on", NEW_PATHS)]
     for title, paths in groups:
         rows = [p for p in paths if "/".join(p) in results]
         if not rows:
             continue
-        o.append(f"| **{title}** | | | | | | | | | | | | | | | |")
+        o.append(f"| **{title}** | | | | | | | | | | | | | | | | |")
         for cell, src, dst in rows:
             r = results["/".join((cell, src, dst))]
             t, g, lw = r["thesis"], r["guide"], r["leeway"]
@@ -122,6 +124,7 @@ def render(info, results):
             o.append(f"| {name} | {t['boxes']} | {t['ms_total']:.0f} | {100 * t['cf']:.4f} | "
                      f"{t['width_bisected']:.3f} | {100 * g['cf']:.4f} | {g['width_bisected']:.3f} | {lw['boxes']} | "
                      f"{lw['ms_total']:.0f} ({lw['ms_safety']:.0f}) | {100 * lw['cf']:.4f} | {lw['collisions']} | "
+                     f"{lw.get('self_collisions', 0)} | "
                      f"{lw['width_bisected']:.3f} | {lw['width_all']:.3f} | {lw['shrunk']}/{lw['intervals']} | "
                      f"{'yes' if lw['certified'] else 'NO'} | {100 * ratio:.0f} %{mark} |")
     o.append("")
@@ -137,8 +140,9 @@ def render(info, results):
                    if r["leeway"]["width_bisected"] >= 0.7 * r["guide"]["width_bisected"])
         share = statistics.median(r["leeway"]["ms_safety"] / max(1e-9, r["leeway"]["ms_guide"]) for r in rows)
         thesis_leaks = sum(1 for r in rows if r["thesis"]["collisions"] > 0)
+        self_clean = sum(1 for r in rows if r["leeway"].get("self_collisions", 0) == 0)
         o.append(f"- {title}: certified on {certified} of {len(rows)} paths, 0 collisions in leeway cf on "
-                 f"{clean} of {len(rows)}; j1-j3 width >= 70 % of the guide's on {wide} of the {len(qualifying)} "
+                 f"{clean} of {len(rows)} and 0 self-collisions on {self_clean}; j1-j3 width >= 70 % of the guide's on {wide} of the {len(qualifying)} "
                  f"paths whose guide CF is >= 99.9 %; the safety stage takes a median {share:.1f} times the "
                  f"time of the rest of the run; the thesis preset's bounds collide on {thesis_leaks} of "
                  f"{len(rows)} paths.")

@@ -58,27 +58,19 @@ std::string cell_text(const std::string& model_name, const std::string& include,
   return x.str();
 }
 
-// Writes `text` to a hidden file beside `cell_path` (so that the include resolves as it will from
-// the cell), loads it as a Scene and removes it again; MuJoCo's and leeway's messages name the cell.
+// Writes `text` to a temporary file beside `cell_path` (so that the include and the meshes resolve
+// as they will from the cell), loads it as a Scene and removes it again; MuJoCo's and leeway's
+// messages name the cell.
 Scene load_beside(const std::string& cell_path, const std::string& text) {
-  const fs::path target(cell_path);
-  const fs::path tmp =
-      target.parent_path() / ("." + target.filename().string() + ".new" + std::to_string(::getpid()));
-  {
-    std::ofstream out(tmp);
-    if (!out) throw InputError(cell_path + ": cannot write the cell (folder missing or not writable)");
-    out << text;
-  }
+  TempFile tmp(cell_path);
   try {
-    Scene s = Scene::load(tmp.string());
-    fs::remove(tmp);
-    return s;
+    tmp.write(text);
+    tmp.close();
+    return Scene::load(tmp.path());
   } catch (const InputError& e) {
-    std::error_code ec;
-    fs::remove(tmp, ec);
     std::string msg = e.what();
-    for (size_t p = msg.find(tmp.string()); p != std::string::npos; p = msg.find(tmp.string()))
-      msg.replace(p, tmp.string().size(), cell_path);
+    for (size_t p = msg.find(tmp.path()); p != std::string::npos; p = msg.find(tmp.path()))
+      msg.replace(p, tmp.path().size(), cell_path);
     throw InputError(msg);
   }
 }

@@ -15,6 +15,8 @@
 #include <new>
 #include <string>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include "cli/common.hpp"
 #include "json_io.hpp"
@@ -95,11 +97,11 @@ TEST(OutputFiles, NonRegularTargetsAndInputsAreRefused) {
   EXPECT_TRUE(fs::is_character_file("/dev/null"));
   const std::string input = dir.write("cell.xml", "<mujoco/>");
   EXPECT_NE(error_of([&] {
-              require_regular_output((dir.path() / "." / "cell.xml").string(), {input});
+              require_outputs({{(dir.path() / "." / "cell.xml").string(), "--out", {}}}, {input});
             }).find("is the input file"),
             std::string::npos);
-  EXPECT_NO_THROW(require_regular_output((dir.path() / "new.json").string(), {input}));
-  EXPECT_EQ(error_of([] { require_regular_output(""); }), "the output file name is empty");
+  EXPECT_NO_THROW(require_outputs({{(dir.path() / "new.json").string(), "--out", {}}}, {input}));
+  EXPECT_EQ(error_of([] { write_file_atomic("", "x"); }), "the output file name is empty");
 }
 
 TEST(OutputFiles, WriteFileAtomicReplacesAndLeavesNoTemporary) {
@@ -113,39 +115,73 @@ TEST(OutputFiles, WriteFileAtomicReplacesAndLeavesNoTemporary) {
   EXPECT_EQ(files, 1);
 }
 
-// A process ended by SIGTERM while write_file_atomic is under way leaves no .NAME.tmpPID behind.
-// The temporary file is made a FIFO first, so that the child blocks in open() with it registered.
+// A process ended by SIGTERM while an output file is being written leaves no temporary file
+// behind: the child creates one (as write_file_atomic does), reports its name and waits.
 TEST(OutputFiles, SigtermRemovesTheTemporaryFile) {
   test::TempDir dir;
   const std::string target = (dir.path() / "out.json").string();
-  int sync[2];
-  ASSERT_EQ(::pipe(sync), 0);
+  int names[2];
+  ASSERT_EQ(::pipe(names), 0);
   const pid_t child = ::fork();
   ASSERT_GE(child, 0);
   if (child == 0) {
     install_temp_file_cleanup();
-    char go = 0;
-    if (::read(sync[0], &go, 1) != 1) ::_exit(3);
     try {
-      write_file_atomic(target, "text");
+      TempFile tmp(target);
+      tmp.write("text");
+      const std::string line = tmp.path() + "\n";
+      if (::write(names[1], line.data(), line.size()) != static_cast<ssize_t>(line.size())) ::_exit(3);
+      ::pause();
     } catch (...) {
       ::_exit(4);
     }
     ::_exit(5);
   }
-  const std::string tmp = (dir.path() / (".out.json.tmp" + std::to_string(child))).string();
-  ASSERT_EQ(::mkfifo(tmp.c_str(), 0600), 0);
-  ASSERT_EQ(::write(sync[1], "g", 1), 1);
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  ASSERT_TRUE(fs::exists(tmp));
+  ::close(names[1]);
+  std::string tmp;
+  char c = 0;
+  while (::read(names[0], &c, 1) == 1 && c != '\n') tmp += c;
+  ::close(names[0]);
+  ASSERT_FALSE(tmp.empty());
+  ASSERT_TRUE(fs::is_regular_file(tmp)) << tmp;
+  EXPECT_EQ(fs::path(tmp).parent_path(), dir.path());
   ::kill(child, SIGTERM);
   int status = 0;
   ASSERT_EQ(::waitpid(child, &status, 0), child);
   EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << status;
   EXPECT_FALSE(fs::exists(tmp));
   EXPECT_FALSE(fs::exists(target));
-  ::close(sync[0]);
-  ::close(sync[1]);
+}
+
+// The reported attack on each writing program: a link to a victim file planted at the temporary
+// name leeway used to use, .NAME.tmpPID (the shell execs the program, so $$ is its PID). The victim
+// keeps its content, the link stays, the output is a regular file.
+TEST(OutputFiles, ProgramsLeaveALinkAtTheOldTemporaryNameAlone) {
+  const std::string tune = (fs::path(LEEWAY_CLI).parent_path() / "leeway-tune").string();
+  const std::string ok = kCorpus + "/cells/ok.xml";
+  const std::vector<std::pair<std::string, std::string>> runs = {
+      {"b.json", std::string(LEEWAY_CLI) + " bounds " + ok + " --from a --to b --safety none --out b.json"},
+      {"v.xml",
+       std::string(LEEWAY_CLI) + " bounds " + ok + " --from a --to b --safety none --export-mjcf v.xml"},
+      {"p.json", std::string(LEEWAY_CLI) + " plan " + ok + " --from a --to b --out p.json"},
+      {"t.json", tune + " --case " + ok + ":a:b --budget-evals 2 --no-summary --threads 1 --out t.json"},
+  };
+  for (const auto& [out, command] : runs) {
+    test::TempDir dir;
+    const std::string victim = dir.write("victim", "keep\n");
+    const auto r = test::run_program("cd " + dir.path().string() + " && bash -c",
+                                     "'ln -s " + victim + " ." + out + ".tmp$$; exec " + command + "'");
+    ASSERT_EQ(r.exit_code, 0) << command << "\n" << r.out;
+    EXPECT_EQ(read_text(victim), "keep\n") << command;
+    EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(dir.path() / out))) << command;
+    int links = 0;
+    for (const auto& e : fs::directory_iterator(dir.path()))
+      if (fs::is_symlink(e.symlink_status())) {
+        ++links;
+        EXPECT_EQ(fs::read_symlink(e.path()).string(), victim);
+      }
+    EXPECT_EQ(links, 1) << command;
+  }
 }
 
 // ------------------------------------------------------------------------- threads and memory

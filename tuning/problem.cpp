@@ -238,19 +238,9 @@ void load(Problem& pb) {
   }
 
   // Output files: fail now rather than after the search.
-  for (const auto& [file, flag] : {std::pair{o.out, "--out"}, {o.report, "--report"}, {o.log, "--log"}}) {
-    if (file.empty()) continue;
-    const auto dir = std::filesystem::absolute(file).parent_path();
-    require(std::filesystem::is_directory(dir),
-            std::string(flag) + " " + file + ": the directory " + dir.string() + " does not exist");
-    std::vector<std::string> inputs = {o.params, o.noise_center};
-    for (const auto& text : o.cases) inputs.push_back(leeway::parse_case(text).cell);
-    try {
-      leeway::require_regular_output(file, inputs);
-    } catch (const InputError& e) {
-      throw InputError(std::string(flag) + " " + e.what());
-    }
-  }
+  std::vector<std::string> inputs = {o.params, o.noise_center};
+  for (const auto& text : o.cases) inputs.push_back(leeway::parse_case(text).cell);
+  leeway::require_outputs({{o.out, "--out", {}}, {o.report, "--report", {}}, {o.log, "--log", {}}}, inputs);
 
   pb.report["command"] = pb.command;
   pb.report["machine"] = {{"cpu", cpu_model()}, {"hardware_threads", std::thread::hardware_concurrency()}};

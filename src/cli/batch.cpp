@@ -81,8 +81,7 @@ int run_batch(const BatchArgs& args) {
     throw InputError("--threads " + std::to_string(args.threads) + " must be >= 1 (or 0: the default)");
   // Everything is checked before the first scenario runs.
   const Suite suite = read_suite(args.suite);
-  if (!args.junit.empty()) require_output(args.junit, "--junit", {".xml"});
-  if (!args.out.empty()) require_output(args.out, "--out", {".json"});
+  require_outputs({{args.junit, "--junit", {".xml"}}, {args.out, "--out", {".json"}}}, {});
   const size_t n = suite.scenarios.size();
   std::cout << "suite " << suite.name << ": " << n << " scenario" << (n == 1 ? "" : "s") << " on "
             << pool->size() << " rank" << (pool->size() == 1 ? "" : "s") << " x " << threads << " thread"

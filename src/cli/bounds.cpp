@@ -114,11 +114,10 @@ int run_bounds(const BoundsArgs& args) {
   p.validate();
   require_threads(args.threads);
   const std::vector<std::string> inputs = {args.cell, args.params, args.path};
-  if (!args.out.empty()) require_output(args.out, "--out", {}, inputs);
-  if (!args.export_mjcf.empty()) require_output(args.export_mjcf, "--export-mjcf", {".xml"}, inputs);
-  if (!args.export_mjb.empty()) require_output(args.export_mjb, "--export-mjb", {".mjb"}, inputs);
-  require_distinct_outputs(
-      {{args.out, "--out"}, {args.export_mjcf, "--export-mjcf"}, {args.export_mjb, "--export-mjb"}});
+  require_outputs({{args.out, "--out", {}},
+                   {args.export_mjcf, "--export-mjcf", {".xml"}},
+                   {args.export_mjb, "--export-mjb", {".mjb"}}},
+                  inputs);
   std::vector<Eigen::VectorXd> path;
   std::string label = args.from + " -> " + args.to;
   const bool linear = args.path.empty() && !is_gripper_goal(args.from) && !is_gripper_goal(args.to);

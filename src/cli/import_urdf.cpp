@@ -31,7 +31,7 @@ CLI::App* add_import_urdf(CLI::App& app, ImportUrdfArgs& args) {
 }
 
 int run_import_urdf(const ImportUrdfArgs& args) {
-  require_output(args.out, "--out", {}, {args.urdf});
+  require_outputs({{args.out, "--out", {}}}, {args.urdf});
   UrdfImportOptions options;
   options.package_paths = args.package_paths;
   if (const char* env = std::getenv("ROS_PACKAGE_PATH")) options.ros_package_path = env;

@@ -5,6 +5,7 @@
 
 #include "cli/common.hpp"
 #include "leeway/error.hpp"
+#include "leeway/file_io.hpp"
 #include "leeway/new_cell.hpp"
 
 namespace leeway::cli {
@@ -23,7 +24,7 @@ CLI::App* add_new_cell(CLI::App& app, NewCellArgs& args) {
 }
 
 int run_new_cell(const NewCellArgs& args) {
-  require_output(args.out, "--out", {}, {args.robot});
+  require_outputs({{args.out, "--out", {}}}, {args.robot});
   const std::string name = args.name.empty() ? std::filesystem::path(args.out).stem().string() : args.name;
   const NewCell cell = write_new_cell(args.robot, args.out, name);
   std::cout << "wrote " << args.out << ": includes " << cell.robot_include << ", " << cell.joints

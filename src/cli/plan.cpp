@@ -52,7 +52,7 @@ CLI::App* add_plan(CLI::App& app, PlanArgs& args) {
 
 int run_plan(const PlanArgs& args) {
   const auto scene = Scene::load(args.cell, scene_options(args.tool, args.checker));
-  if (!args.out.empty()) require_output(args.out, "--out", {}, {args.cell});
+  require_outputs({{args.out, "--out", {}}}, {args.cell});
   PlanOptions options = args.options;
   options.simplify = !args.no_simplify;
   options.try_direct = !args.no_direct;

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <pthread.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/random.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -342,13 +343,24 @@ StreamingOutput::StreamingOutput(const std::string& path, const std::string& wha
       if (const std::string why = not_regular(st); !why.empty()) throw InputError(named + ": " + why);
     throw InputError(named + ": cannot write the file (" + reason_of(err) + ")");
   }
-  struct stat st;
+  struct stat st {};
   if (::fstat(s.fd, &st) != 0 || !S_ISREG(st.st_mode)) {
     ::close(s.fd);
     s.fd = -1;
     throw InputError(named + ": " + not_regular(st));
   }
   ::fcntl(s.fd, F_SETFL, ::fcntl(s.fd, F_GETFL) & ~O_NONBLOCK);
+  if (::flock(s.fd, LOCK_EX | LOCK_NB) != 0) {
+    const int err = errno;
+    ::close(s.fd);
+    s.fd = -1;
+    if (err == EWOULDBLOCK)
+      throw InputError(named +
+                       ": the file is locked by another process writing it (another run with the "
+                       "same " +
+                       what + "?); give another file or wait until that run has ended");
+    throw InputError(named + ": cannot lock the file (" + reason_of(err) + ")");
+  }
   s.out.exceptions(std::ios::badbit);  // a failed write throws the InputError above
 }
 

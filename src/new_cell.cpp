@@ -11,6 +11,7 @@
 #include "leeway/check.hpp"
 #include "leeway/error.hpp"
 #include "leeway/file_io.hpp"
+#include "leeway/mjcf_source.hpp"
 #include "leeway/scene.hpp"
 #include "mjcf_text.hpp"
 
@@ -60,13 +61,20 @@ std::string cell_text(const std::string& model_name, const std::string& include,
 
 // Writes `text` to a temporary file beside `cell_path` (so that the include and the meshes resolve
 // as they will from the cell), loads it as a Scene and removes it again; MuJoCo's and leeway's
-// messages name the cell.
-Scene load_beside(const std::string& cell_path, const std::string& text) {
+// messages name the cell. `inputs`, when given, receives the files the cell reads (the robot, its
+// includes and meshes).
+Scene load_beside(const std::string& cell_path, const std::string& text,
+                  std::vector<std::string>* inputs = nullptr) {
   TempFile tmp(cell_path);
   try {
     tmp.write(text);
     tmp.close();
-    return Scene::load(tmp.path());
+    Scene s = Scene::load(tmp.path());
+    if (inputs) {
+      *inputs = model_input_files(tmp.path());
+      inputs->erase(inputs->begin());  // the temporary file itself
+    }
+    return s;
   } catch (const InputError& e) {
     std::string msg = e.what();
     for (size_t p = msg.find(tmp.path()); p != std::string::npos; p = msg.find(tmp.path()))
@@ -138,13 +146,16 @@ NewCell write_new_cell(const std::string& robot_path, const std::string& cell_pa
   out.mjcf = cell_text(model_name, out.robot_include, robot_name, out.reach_radius, out.home);
 
   // Then the cell itself, checked before it is moved into place.
-  const Scene scene = load_beside(cell_path, out.mjcf);
+  std::vector<std::string> inputs;
+  const Scene scene = load_beside(cell_path, out.mjcf, &inputs);
   const CheckReport report = check_scene(scene);
   if (!report.ok()) {
     std::string problems;
     for (const auto& p : report.problems) problems += (problems.empty() ? "" : "; ") + p;
     throw InputError(cell_path + ": the new cell fails leeway's check: " + problems);
   }
+  // The cell may not replace the robot, a file it includes or a mesh it names.
+  require_outputs({{cell_path, "", {}}}, inputs);
   write_file_atomic(cell_path, out.mjcf);
   return out;
 }

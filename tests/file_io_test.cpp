@@ -1,6 +1,6 @@
 // The output-path policy (file_io.hpp): temporary files that never follow or reuse a name someone
 // else placed, outputs refused when they are links, inputs of the run or each other, and streamed
-// outputs opened without following a link.
+// outputs locked against a second writer.
 #include "leeway/file_io.hpp"
 
 #include <gmock/gmock.h>
@@ -202,6 +202,20 @@ TEST(RequireOutputsTest, LinksFoldersAndMissingFoldersAreRefused) {
 }
 
 // ---------------------------------------------------------------------------- StreamingOutput
+
+TEST(StreamingOutputTest, ASecondWriterIsRefusedWhileTheFirstHoldsTheLock) {
+  test::TempDir dir;
+  const std::string log = (dir.path() / "log.csv").string();
+  StreamingOutput first(log, "--log");
+  first.truncate();
+  first.stream() << "a,b\n" << std::flush;
+  EXPECT_THAT(error_of([&] { StreamingOutput second(log, "--log"); }),
+              HasSubstr("--log " + log + ": the file is locked by another process writing it"));
+  first.stream() << "1,2\n" << std::flush;
+  EXPECT_EQ(read_text(log), "a,b\n1,2\n");  // no rows of the refused writer, none lost
+  first = StreamingOutput();                // closed: the lock is released
+  EXPECT_NO_THROW(StreamingOutput again(log, "--log"));
+}
 
 TEST(StreamingOutputTest, TheOldContentStaysUntilTruncateAndANewFileUnusedIsRemoved) {
   test::TempDir dir;

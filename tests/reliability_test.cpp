@@ -25,6 +25,7 @@
 #include "leeway/mujoco_util.hpp"
 #include "leeway/scene.hpp"
 #include "parallel.hpp"
+#include "stl_util.hpp"
 #include "test_util.hpp"
 
 namespace leeway {
@@ -184,6 +185,61 @@ TEST(OutputFiles, ProgramsLeaveALinkAtTheOldTemporaryNameAlone) {
   }
 }
 
+// A cell whose obstacle is a mesh: `plan --out` and `bounds --out` may not replace the STL file, nor
+// `import-urdf --out` the mesh its own URDF names.
+TEST(OutputFiles, MeshesTheRunReadsAreNotReplaced) {
+  test::TempDir dir;
+  fs::create_directories(dir.path() / "assets");
+  const std::string stl = (dir.path() / "assets" / "cube.stl").string();
+  test::write_binary_stl(stl, test::cuboid({-0.1, -0.1, -0.1}, {0.1, 0.1, 0.1}));
+  std::string cell = read_text(kCorpus + "/cells/ok.xml");
+  cell.replace(cell.find("<worldbody>"), 0, R"(<compiler meshdir="assets"/>
+  <asset><mesh name="cube" file="cube.stl"/></asset>
+  )");
+  cell.replace(
+      cell.find("</worldbody>"), 0,
+      R"(  <geom name="crate" type="mesh" mesh="cube" pos="-0.6 0.6 0.1" contype="0" conaffinity="1"/>
+  )");
+  const std::string cell_path = dir.write("cell.xml", cell);
+  const std::string before = read_text(stl);
+  for (const std::string& command : {"plan " + cell_path + " --from a --to b --out " + stl,
+                                     "bounds " + cell_path + " --from a --to b --out " + stl}) {
+    const auto r = test::run_cli(command);
+    EXPECT_EQ(r.exit_code, 2) << r.out;
+    EXPECT_NE(r.out.find("--out " + stl + ": the output file is the input file " + dir.path().string() +
+                         "/assets/cube.stl"),
+              std::string::npos)
+        << r.out;
+    EXPECT_EQ(read_text(stl), before);
+  }
+  const std::string urdf = dir.write("arm.urdf", R"(<robot name="arm">
+  <link name="base"/>
+  <link name="tool0"><collision><geometry><mesh filename="assets/cube.stl"/></geometry></collision></link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="tool0"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>)");
+  const auto r = test::run_cli("import-urdf " + urdf + " --out " + stl);
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.out.find("--out " + stl + ": the output file is the input file"), std::string::npos) << r.out;
+  EXPECT_EQ(read_text(stl), before);
+}
+
+// new-cell may not replace a file its robot fragment includes (resolved from the cell's folder).
+TEST(OutputFiles, NewCellDoesNotReplaceWhatTheRobotIncludes) {
+  test::TempDir dir;
+  std::string robot = read_text(kCorpus + "/robots/one_link.xml");
+  const std::string marker =
+      "<mujoco><geom name=\"marker\" type=\"sphere\" size=\"0.01\" contype=\"0\" "
+      "conaffinity=\"0\"/></mujoco>\n";
+  const std::string part = dir.write("part.xml", marker);
+  robot.replace(robot.find("  <body name=\"base\">"), 0, "  <include file=\"part.xml\"/>\n");
+  const std::string robot_path = dir.write("robot.xml", robot);
+  const auto r = test::run_cli("new-cell --robot " + robot_path + " --out " + part);
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.out.find(part + ": the output file is the input file"), std::string::npos) << r.out;
+  EXPECT_EQ(read_text(part), marker);
+}
+
 // ------------------------------------------------------------------------- threads and memory
 
 // Under an address-space limit that leaves no room for more thread stacks, parallel_for runs every
@@ -306,6 +362,23 @@ TEST(ValidCells, AWorldBodyEndTagInACommentIsJustAComment) {
              b = nlohmann::json::parse(read_text(commented_out));
   EXPECT_EQ(a["waypoints"], b["waypoints"]);
   EXPECT_EQ(a["boxes"], b["boxes"]);
+}
+
+// Two runs with one --log: the second is refused before any work while the first holds the log's
+// lock (flock(1) holds it here), and the log keeps the first run's rows.
+TEST(Tune, ALogLockedByAnotherRunIsRefused) {
+  test::TempDir dir;
+  const std::string tune = (fs::path(LEEWAY_CLI).parent_path() / "leeway-tune").string();
+  const std::string log = dir.write("log.csv", "the first run's rows\n");
+  const auto r = test::run_program("flock " + log + " " + tune,
+                                   "--case " + kCorpus + "/cells/ok.xml:a:b --budget-evals 1 --log " + log +
+                                       " --out " + (dir.path() / "t.json").string());
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.out.find("--log " + log + ": the file is locked by another process writing it"),
+            std::string::npos)
+      << r.out;
+  EXPECT_EQ(read_text(log), "the first run's rows\n");
+  EXPECT_FALSE(fs::exists(dir.path() / "t.json"));
 }
 
 // SIGINT during leeway-tune's calibration keeps an existing --log as it was.

@@ -142,7 +142,8 @@ int main(int argc, char** argv) {
       return leeway::kExitOk;
     }
     pb.pool = pool.get();
-    // The log is opened before any work; its old content stays until the calibration is done.
+    // The log is locked before any work (a second run with the same --log is refused now rather
+    // than interleaving its rows); its old content stays until the calibration is done.
     leeway::StreamingOutput log;
     if (!o.log.empty()) log = leeway::StreamingOutput(o.log, "--log");
     install_sigint_handler();

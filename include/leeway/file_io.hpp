@@ -73,16 +73,17 @@ class TempFile {
 void write_file_atomic(const std::string& path, const std::string& text);
 
 //! An output file written as the run goes (a log or table whose rows are kept if the run is
-//! interrupted): opened without following a symbolic link and refused unless a regular file. The
-//! file's previous content is kept until truncate().
+//! interrupted): opened without following a symbolic link, refused unless a regular file, and held
+//! with an exclusive lock (flock) for as long as the object lives, so that two runs never interleave
+//! their rows in one file. The file's previous content is kept until truncate().
 class StreamingOutput {
  public:
   StreamingOutput();
-  //! Opens (creating it with mode 0644 less the umask) `path`. `what` names it in messages ("--log").
-  //! @throws InputError naming `what` and the path: the folder is missing or not writable, or the
-  //! path is a symbolic link or not a regular file.
+  //! Opens (creating it with mode 0644 less the umask) and locks `path`. `what` names it in messages
+  //! ("--log"). @throws InputError naming `what` and the path: the folder is missing or not writable,
+  //! the path is a symbolic link or not a regular file, or another process holds the lock.
   StreamingOutput(const std::string& path, const std::string& what);
-  //! Closes the file; a file the constructor created and truncate()
+  //! Closes the file (and so releases the lock); a file the constructor created and truncate()
   //! never touched is removed, so that a run refused or interrupted early leaves none.
   ~StreamingOutput();
   StreamingOutput(StreamingOutput&& other) noexcept;

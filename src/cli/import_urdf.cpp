@@ -49,6 +49,8 @@ int run_import_urdf(const ImportUrdfArgs& args) {
                                                          : "--base-link LINK";
     throw InputError(std::string(e.what()) + " (see " + flag + ")");
   }
+  // The meshes the URDF names are known once it is read: the output may replace none of them.
+  require_outputs({{args.out, "--out", {}}}, robot.inputs);
   write_file_atomic(args.out, robot.mjcf);
   std::cout << "wrote " << args.out << ": robot '" << robot.robot_name << "', " << robot.joints.size()
             << " joints (";

@@ -24,6 +24,8 @@ CLI::App* add_new_cell(CLI::App& app, NewCellArgs& args) {
 }
 
 int run_new_cell(const NewCellArgs& args) {
+  // The files the robot includes and its meshes are checked by write_new_cell, resolved from the
+  // cell's folder as MuJoCo will.
   require_outputs({{args.out, "--out", {}}}, {args.robot});
   const std::string name = args.name.empty() ? std::filesystem::path(args.out).stem().string() : args.name;
   const NewCell cell = write_new_cell(args.robot, args.out, name);

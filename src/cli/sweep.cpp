@@ -11,6 +11,7 @@
 
 #include "cli/plot.hpp"
 #include "leeway/file_io.hpp"
+#include "leeway/mjcf_source.hpp"
 #include "leeway/nominal_path.hpp"
 #include "leeway/path_check.hpp"
 #include "leeway/pipeline.hpp"
@@ -96,10 +97,11 @@ int run_sweep(const SweepArgs& args) {
     require_memory(args.waypoints * kBytesPerWaypoint, "--waypoints " + std::to_string(args.waypoints));
   if (cf.windows >= 1)
     require_memory(cf.windows * kBytesPerWindow, "CF windows " + std::to_string(cf.windows));
-  require_outputs({{args.plot, "--plot", {".svg", ".png"}}, {args.csv, "--csv", {}}},
-                  {args.cell, args.params});
+  std::vector<std::string> inputs = model_input_files(args.cell);
+  inputs.push_back(args.params);
+  require_outputs({{args.plot, "--plot", {".svg", ".png"}}, {args.csv, "--csv", {}}}, inputs);
   // Rows are written as they finish (standard output and --csv, flushed), so that an interrupted
-  // sweep keeps the rows it finished; the CSV is opened now, its old content kept until the first row.
+  // sweep keeps the rows it finished; the CSV is locked now, its old content kept until the first row.
   StreamingOutput csv_file;
   if (!args.csv.empty()) csv_file = StreamingOutput(args.csv, "--csv");
   require_threads(args.threads);

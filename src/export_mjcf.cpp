@@ -3,8 +3,10 @@
 #include <unistd.h>
 
 #include <cctype>
+#include <cerrno>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -224,19 +226,22 @@ std::string volume_mjb(const std::string& cell_path, const std::vector<Box>& box
   }
   take_mujoco_warnings();
   // mj_sizeModel counts the in-memory alignment padding that mj_saveModel does not write (a loader
-  // then warns "Model file is too large"), so save to a scratch file and take its bytes.
-  const fs::path scratch =
-      fs::temp_directory_path() / ("leeway-export-" + std::to_string(::getpid()) + "-" +
-                                   std::to_string(reinterpret_cast<std::uintptr_t>(m.get())) + ".mjb");
-  mj_saveModel(m.get(), scratch.c_str(), nullptr, 0);
+  // then warns "Model file is too large"), so save to a scratch file and take its bytes. The file is
+  // in a folder of its own that only this user can enter (mkdtemp, mode 0700): mj_saveModel opens
+  // its file with fopen, which would follow a link another user planted at a predictable name.
+  std::string folder = (fs::temp_directory_path() / "leeway-export-XXXXXX").string();
+  if (!::mkdtemp(folder.data()))
+    throw InputError(folder + ": cannot make a scratch folder for the MJB (" + std::strerror(errno) + ")");
+  const fs::path scratch = fs::path(folder) / "model.mjb";
   std::string bytes;
   {
+    mj_saveModel(m.get(), scratch.c_str(), nullptr, 0);
     std::ifstream in(scratch, std::ios::binary);
-    if (!in) throw std::runtime_error("MuJoCo did not save the model to " + scratch.string());
-    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    if (in) bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
   std::error_code ec;
-  fs::remove(scratch, ec);
+  fs::remove_all(folder, ec);
+  if (bytes.empty()) throw std::runtime_error("MuJoCo did not save the model to " + scratch.string());
   return bytes;
 }
 

@@ -8,6 +8,7 @@
 
 #include "leeway/error.hpp"
 #include "leeway/file_io.hpp"
+#include "leeway/mjcf_source.hpp"
 
 namespace leeway {
 namespace {
@@ -78,6 +79,17 @@ ModelPtr load_model_file(const std::string& path) {
     m = mj_loadModel(path.c_str(), nullptr);
     if (!m) throw InputError(path + ": not a valid MJB file for MuJoCo " + mj_versionString());
   } else {
+    // Every numeric attribute is checked before MuJoCo sees it: MuJoCo 2.2.2 reads "nan" as 0
+    // (a body, a geom's orientation) with only a warning, and "inf" as it is.
+    try {
+      read_mjcf_source(path);
+    } catch (const MjcfSyntaxError&) {
+      // MuJoCo's message for a file that is not well-formed XML names the line and element.
+      m = mj_loadXML(path.c_str(), nullptr, error, sizeof(error));
+      if (!m) throw InputError(path + ": MJCF does not compile: " + one_line(error));
+      mj_deleteModel(m);
+      throw;
+    }
     m = mj_loadXML(path.c_str(), nullptr, error, sizeof(error));
     if (!m) throw InputError(path + ": MJCF does not compile: " + one_line(error));
   }

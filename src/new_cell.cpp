@@ -12,6 +12,7 @@
 #include "leeway/error.hpp"
 #include "leeway/file_io.hpp"
 #include "leeway/kinematics.hpp"
+#include "leeway/mjcf_source.hpp"
 #include "leeway/scene.hpp"
 #include "leeway/urdf_import.hpp"
 #include "mjcf_text.hpp"
@@ -67,27 +68,26 @@ std::string cell_text(const std::string& model_name, const std::string& include,
   return x.str();
 }
 
-// Writes `text` to a hidden file beside `cell_path` (so that the include resolves as it will from
-// the cell), loads it as a Scene and removes it again; MuJoCo's and leeway's messages name the cell.
-Scene load_beside(const std::string& cell_path, const std::string& text) {
-  const fs::path target(cell_path);
-  const fs::path tmp =
-      target.parent_path() / ("." + target.filename().string() + ".new" + std::to_string(::getpid()));
-  {
-    std::ofstream out(tmp);
-    if (!out) throw InputError(cell_path + ": cannot write the cell (folder missing or not writable)");
-    out << text;
-  }
+// Writes `text` to a temporary file beside `cell_path` (so that the include and the meshes resolve
+// as they will from the cell), loads it as a Scene and removes it again; MuJoCo's and leeway's
+// messages name the cell. `inputs`, when given, receives the files the cell reads (the robot, its
+// includes and meshes).
+Scene load_beside(const std::string& cell_path, const std::string& text,
+                  std::vector<std::string>* inputs = nullptr) {
+  TempFile tmp(cell_path);
   try {
-    Scene s = Scene::load(tmp.string());
-    fs::remove(tmp);
+    tmp.write(text);
+    tmp.close();
+    Scene s = Scene::load(tmp.path());
+    if (inputs) {
+      *inputs = model_input_files(tmp.path());
+      inputs->erase(inputs->begin());  // the temporary file itself
+    }
     return s;
   } catch (const InputError& e) {
-    std::error_code ec;
-    fs::remove(tmp, ec);
     std::string msg = e.what();
-    for (size_t p = msg.find(tmp.string()); p != std::string::npos; p = msg.find(tmp.string()))
-      msg.replace(p, tmp.string().size(), cell_path);
+    for (size_t p = msg.find(tmp.path()); p != std::string::npos; p = msg.find(tmp.path()))
+      msg.replace(p, tmp.path().size(), cell_path);
     throw InputError(msg);
   }
 }
@@ -195,7 +195,8 @@ NewCell write_new_cell(const std::string& robot_path, const std::string& cell_pa
                        out.excludes_include, texts);
 
   // Then the cell itself, checked before it is moved into place.
-  const Scene scene = load_beside(cell_path, out.mjcf);
+  std::vector<std::string> inputs;
+  const Scene scene = load_beside(cell_path, out.mjcf, &inputs);
   out.self_pairs = static_cast<int>(scene.self_pairs().size());
   const CheckReport report = check_scene(scene);
   if (!report.ok()) {
@@ -203,6 +204,8 @@ NewCell write_new_cell(const std::string& robot_path, const std::string& cell_pa
     for (const auto& p : report.problems) problems += (problems.empty() ? "" : "; ") + p;
     throw InputError(cell_path + ": the new cell fails leeway's check: " + problems);
   }
+  // The cell may not replace the robot, a file it includes or a mesh it names.
+  require_outputs({{cell_path, "", {}}}, inputs);
   write_file_atomic(cell_path, out.mjcf);
   return out;
 }

@@ -479,6 +479,7 @@ class Importer {
     const Vector3d scale(mesh.scale.x, mesh.scale.y, mesh.scale.z);
     if (!scale.allFinite() || (scale.array() == 0).any())
       throw InputError(m + " scale '" + vector3_text(mesh.scale) + "' must be finite and non-zero");
+    meshes_read_.push_back(path);
     StlMesh stl;
     try {
       stl = read_stl(path);
@@ -578,6 +579,8 @@ class Importer {
     x << "</mujoco>\n";
     out.mjcf = x.str();
     out.notes = notes_;
+    out.inputs = {file_};
+    out.inputs.insert(out.inputs.end(), meshes_read_.begin(), meshes_read_.end());
     return out;
   }
 
@@ -733,6 +736,7 @@ class Importer {
   std::set<std::string> chain_;  // joint names from the base to the tool
   std::vector<Body> bodies_;
   std::vector<std::string> notes_;
+  std::vector<std::string> meshes_read_;
   std::set<std::string> geom_names_;
 };
 

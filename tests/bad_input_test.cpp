@@ -3,6 +3,7 @@
 // message each must give; every entry is one test, run in a fresh temporary folder.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -49,7 +50,18 @@ TEST_P(BadInputCorpus, ExitCodeAndMessage) {
   if (c.contains("fifo")) {
     ASSERT_EQ(::mkfifo(expand(c.at("fifo"), tmp).c_str(), 0600), 0);
   }
-  if (c.contains("copy")) fs::copy_file(expand(c.at("copy")[0], tmp), expand(c.at("copy")[1], tmp));
+  if (c.contains("copy")) {
+    // One [from, to] pair or a list of them; folders of `to` are made.
+    const json pairs = c.at("copy")[0].is_array() ? c.at("copy") : json::array({c.at("copy")});
+    for (const auto& pair : pairs) {
+      const fs::path to = expand(pair[1], tmp);
+      fs::create_directories(to.parent_path());
+      fs::copy_file(expand(pair[0], tmp), to);
+    }
+  }
+  if (c.contains("symlink")) {
+    ASSERT_EQ(::symlink(expand(c.at("symlink")[0], tmp).c_str(), expand(c.at("symlink")[1], tmp).c_str()), 0);
+  }
   const std::string unchanged = c.contains("unchanged") ? expand(c.at("unchanged"), tmp) : "";
   const std::string before = unchanged.empty() ? "" : read_text(unchanged);
 
@@ -64,9 +76,8 @@ TEST_P(BadInputCorpus, ExitCodeAndMessage) {
   const std::string all = r.out + stderr_text;
   const std::string name = c.at("name");
   EXPECT_EQ(r.exit_code, c.at("exit").get<int>()) << name << ":\n" << all;
-  EXPECT_NE(all.find(c.at("message").get<std::string>()), std::string::npos)
-      << name << ": expected '" << c.at("message").get<std::string>() << "' in:\n"
-      << all;
+  const std::string message = expand(c.at("message"), tmp);
+  EXPECT_NE(all.find(message), std::string::npos) << name << ": expected '" << message << "' in:\n" << all;
   EXPECT_EQ(all.find("internal error"), std::string::npos) << name << ":\n" << all;
   if (c.contains("stderr_lines")) {
     EXPECT_EQ(std::count(stderr_text.begin(), stderr_text.end(), '\n'), c.at("stderr_lines").get<int>())
@@ -78,6 +89,12 @@ TEST_P(BadInputCorpus, ExitCodeAndMessage) {
   }
   if (!unchanged.empty()) {
     EXPECT_EQ(read_text(unchanged), before) << name << ": " << unchanged << " changed";
+  }
+  if (c.contains("symlink")) {
+    // The link is still there, still pointing where it did.
+    const fs::path link = expand(c.at("symlink")[1], tmp);
+    EXPECT_TRUE(fs::is_symlink(fs::symlink_status(link))) << name << ": " << link << " is no longer a link";
+    EXPECT_EQ(fs::read_symlink(link).string(), expand(c.at("symlink")[0], tmp)) << name;
   }
 }
 

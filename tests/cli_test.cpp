@@ -50,7 +50,7 @@ TEST(CliTest, BadInputsExitTwoWithOneMessage) {
       {"check " + dir.path().string() + "/absent.xml", {"absent.xml", "cannot open"}},
       {"check " + malformed, {"bad.xml", "does not compile"}},
       {"check " + no_robot, {"norobot.xml", "no robot joints"}},
-      {"check " + nan_key, {"nan.xml", "keyframe 'k'", "'nan'"}},
+      {"check " + nan_key, {"nan.xml", "key 'k' qpos 'nan' is not finite"}},
       {"check " + short_key, {"short.xml", "qpos size"}},
       {"fk " + workcell("dallara") + " --q \"0 0 nan 0 0 0\"", {"dallara.xml --q", "'nan'"}},
       {"fk " + workcell("dallara") + " --q \"0 0 inf 0 0 0\"", {"'inf'", "not finite"}},

@@ -15,6 +15,8 @@
 #include <new>
 #include <string>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include "cli/common.hpp"
 #include "json_io.hpp"
@@ -23,6 +25,7 @@
 #include "leeway/mujoco_util.hpp"
 #include "leeway/scene.hpp"
 #include "parallel.hpp"
+#include "stl_util.hpp"
 #include "test_util.hpp"
 
 namespace leeway {
@@ -95,11 +98,11 @@ TEST(OutputFiles, NonRegularTargetsAndInputsAreRefused) {
   EXPECT_TRUE(fs::is_character_file("/dev/null"));
   const std::string input = dir.write("cell.xml", "<mujoco/>");
   EXPECT_NE(error_of([&] {
-              require_regular_output((dir.path() / "." / "cell.xml").string(), {input});
+              require_outputs({{(dir.path() / "." / "cell.xml").string(), "--out", {}}}, {input});
             }).find("is the input file"),
             std::string::npos);
-  EXPECT_NO_THROW(require_regular_output((dir.path() / "new.json").string(), {input}));
-  EXPECT_EQ(error_of([] { require_regular_output(""); }), "the output file name is empty");
+  EXPECT_NO_THROW(require_outputs({{(dir.path() / "new.json").string(), "--out", {}}}, {input}));
+  EXPECT_EQ(error_of([] { write_file_atomic("", "x"); }), "the output file name is empty");
 }
 
 TEST(OutputFiles, WriteFileAtomicReplacesAndLeavesNoTemporary) {
@@ -113,39 +116,128 @@ TEST(OutputFiles, WriteFileAtomicReplacesAndLeavesNoTemporary) {
   EXPECT_EQ(files, 1);
 }
 
-// A process ended by SIGTERM while write_file_atomic is under way leaves no .NAME.tmpPID behind.
-// The temporary file is made a FIFO first, so that the child blocks in open() with it registered.
+// A process ended by SIGTERM while an output file is being written leaves no temporary file
+// behind: the child creates one (as write_file_atomic does), reports its name and waits.
 TEST(OutputFiles, SigtermRemovesTheTemporaryFile) {
   test::TempDir dir;
   const std::string target = (dir.path() / "out.json").string();
-  int sync[2];
-  ASSERT_EQ(::pipe(sync), 0);
+  int names[2];
+  ASSERT_EQ(::pipe(names), 0);
   const pid_t child = ::fork();
   ASSERT_GE(child, 0);
   if (child == 0) {
     install_temp_file_cleanup();
-    char go = 0;
-    if (::read(sync[0], &go, 1) != 1) ::_exit(3);
     try {
-      write_file_atomic(target, "text");
+      TempFile tmp(target);
+      tmp.write("text");
+      const std::string line = tmp.path() + "\n";
+      if (::write(names[1], line.data(), line.size()) != static_cast<ssize_t>(line.size())) ::_exit(3);
+      ::pause();
     } catch (...) {
       ::_exit(4);
     }
     ::_exit(5);
   }
-  const std::string tmp = (dir.path() / (".out.json.tmp" + std::to_string(child))).string();
-  ASSERT_EQ(::mkfifo(tmp.c_str(), 0600), 0);
-  ASSERT_EQ(::write(sync[1], "g", 1), 1);
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  ASSERT_TRUE(fs::exists(tmp));
+  ::close(names[1]);
+  std::string tmp;
+  char c = 0;
+  while (::read(names[0], &c, 1) == 1 && c != '\n') tmp += c;
+  ::close(names[0]);
+  ASSERT_FALSE(tmp.empty());
+  ASSERT_TRUE(fs::is_regular_file(tmp)) << tmp;
+  EXPECT_EQ(fs::path(tmp).parent_path(), dir.path());
   ::kill(child, SIGTERM);
   int status = 0;
   ASSERT_EQ(::waitpid(child, &status, 0), child);
   EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << status;
   EXPECT_FALSE(fs::exists(tmp));
   EXPECT_FALSE(fs::exists(target));
-  ::close(sync[0]);
-  ::close(sync[1]);
+}
+
+// The reported attack on each writing program: a link to a victim file planted at the temporary
+// name leeway used to use, .NAME.tmpPID (the shell execs the program, so $$ is its PID). The victim
+// keeps its content, the link stays, the output is a regular file.
+TEST(OutputFiles, ProgramsLeaveALinkAtTheOldTemporaryNameAlone) {
+  const std::string tune = (fs::path(LEEWAY_CLI).parent_path() / "leeway-tune").string();
+  const std::string ok = kCorpus + "/cells/ok.xml";
+  const std::vector<std::pair<std::string, std::string>> runs = {
+      {"b.json", std::string(LEEWAY_CLI) + " bounds " + ok + " --from a --to b --safety none --out b.json"},
+      {"v.xml",
+       std::string(LEEWAY_CLI) + " bounds " + ok + " --from a --to b --safety none --export-mjcf v.xml"},
+      {"p.json", std::string(LEEWAY_CLI) + " plan " + ok + " --from a --to b --out p.json"},
+      {"t.json", tune + " --case " + ok + ":a:b --budget-evals 2 --no-summary --threads 1 --out t.json"},
+  };
+  for (const auto& [out, command] : runs) {
+    test::TempDir dir;
+    const std::string victim = dir.write("victim", "keep\n");
+    const auto r = test::run_program("cd " + dir.path().string() + " && bash -c",
+                                     "'ln -s " + victim + " ." + out + ".tmp$$; exec " + command + "'");
+    ASSERT_EQ(r.exit_code, 0) << command << "\n" << r.out;
+    EXPECT_EQ(read_text(victim), "keep\n") << command;
+    EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(dir.path() / out))) << command;
+    int links = 0;
+    for (const auto& e : fs::directory_iterator(dir.path()))
+      if (fs::is_symlink(e.symlink_status())) {
+        ++links;
+        EXPECT_EQ(fs::read_symlink(e.path()).string(), victim);
+      }
+    EXPECT_EQ(links, 1) << command;
+  }
+}
+
+// A cell whose obstacle is a mesh: `plan --out` and `bounds --out` may not replace the STL file, nor
+// `import-urdf --out` the mesh its own URDF names.
+TEST(OutputFiles, MeshesTheRunReadsAreNotReplaced) {
+  test::TempDir dir;
+  fs::create_directories(dir.path() / "assets");
+  const std::string stl = (dir.path() / "assets" / "cube.stl").string();
+  test::write_binary_stl(stl, test::cuboid({-0.1, -0.1, -0.1}, {0.1, 0.1, 0.1}));
+  std::string cell = read_text(kCorpus + "/cells/ok.xml");
+  cell.replace(cell.find("<worldbody>"), 0, R"(<compiler meshdir="assets"/>
+  <asset><mesh name="cube" file="cube.stl"/></asset>
+  )");
+  cell.replace(
+      cell.find("</worldbody>"), 0,
+      R"(  <geom name="crate" type="mesh" mesh="cube" pos="-0.6 0.6 0.1" contype="0" conaffinity="1"/>
+  )");
+  const std::string cell_path = dir.write("cell.xml", cell);
+  const std::string before = read_text(stl);
+  for (const std::string& command : {"plan " + cell_path + " --from a --to b --out " + stl,
+                                     "bounds " + cell_path + " --from a --to b --out " + stl}) {
+    const auto r = test::run_cli(command);
+    EXPECT_EQ(r.exit_code, 2) << r.out;
+    EXPECT_NE(r.out.find("--out " + stl + ": the output file is the input file " + dir.path().string() +
+                         "/assets/cube.stl"),
+              std::string::npos)
+        << r.out;
+    EXPECT_EQ(read_text(stl), before);
+  }
+  const std::string urdf = dir.write("arm.urdf", R"(<robot name="arm">
+  <link name="base"/>
+  <link name="tool0"><collision><geometry><mesh filename="assets/cube.stl"/></geometry></collision></link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="tool0"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>)");
+  const auto r = test::run_cli("import-urdf " + urdf + " --out " + stl);
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.out.find("--out " + stl + ": the output file is the input file"), std::string::npos) << r.out;
+  EXPECT_EQ(read_text(stl), before);
+}
+
+// new-cell may not replace a file its robot fragment includes (resolved from the cell's folder).
+TEST(OutputFiles, NewCellDoesNotReplaceWhatTheRobotIncludes) {
+  test::TempDir dir;
+  std::string robot = read_text(kCorpus + "/robots/one_link.xml");
+  const std::string marker =
+      "<mujoco><geom name=\"marker\" type=\"sphere\" size=\"0.01\" contype=\"0\" "
+      "conaffinity=\"0\"/></mujoco>\n";
+  const std::string part = dir.write("part.xml", marker);
+  robot.replace(robot.find("  <body name=\"base\">"), 0, "  <include file=\"part.xml\"/>\n");
+  const std::string robot_path = dir.write("robot.xml", robot);
+  const auto r = test::run_cli("new-cell --robot " + robot_path + " --out " + part);
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.out.find(part + ": the output file is the input file"), std::string::npos) << r.out;
+  EXPECT_EQ(read_text(part), marker);
 }
 
 // ------------------------------------------------------------------------- threads and memory
@@ -270,6 +362,23 @@ TEST(ValidCells, AWorldBodyEndTagInACommentIsJustAComment) {
              b = nlohmann::json::parse(read_text(commented_out));
   EXPECT_EQ(a["waypoints"], b["waypoints"]);
   EXPECT_EQ(a["boxes"], b["boxes"]);
+}
+
+// Two runs with one --log: the second is refused before any work while the first holds the log's
+// lock (flock(1) holds it here), and the log keeps the first run's rows.
+TEST(Tune, ALogLockedByAnotherRunIsRefused) {
+  test::TempDir dir;
+  const std::string tune = (fs::path(LEEWAY_CLI).parent_path() / "leeway-tune").string();
+  const std::string log = dir.write("log.csv", "the first run's rows\n");
+  const auto r = test::run_program("flock " + log + " " + tune,
+                                   "--case " + kCorpus + "/cells/ok.xml:a:b --budget-evals 1 --log " + log +
+                                       " --out " + (dir.path() / "t.json").string());
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.out.find("--log " + log + ": the file is locked by another process writing it"),
+            std::string::npos)
+      << r.out;
+  EXPECT_EQ(read_text(log), "the first run's rows\n");
+  EXPECT_FALSE(fs::exists(dir.path() / "t.json"));
 }
 
 // SIGINT during leeway-tune's calibration keeps an existing --log as it was.

@@ -142,18 +142,18 @@ int main(int argc, char** argv) {
       return leeway::kExitOk;
     }
     pb.pool = pool.get();
+    // The log is locked before any work (a second run with the same --log is refused now rather
+    // than interleaving its rows); its old content stays until the calibration is done.
+    leeway::StreamingOutput log;
+    if (!o.log.empty()) log = leeway::StreamingOutput(o.log, "--log");
     install_sigint_handler();
     if (!calibrate(pb)) {
       std::cerr << "leeway-tune: interrupted before the first evaluation; nothing written\n";
       return kExitInterrupted;
     }
-    // Opened (and an existing log replaced) only now: an interrupted calibration leaves it as it was.
-    std::ofstream log;
-    if (!o.log.empty()) {
-      log.open(o.log);
-      require(static_cast<bool>(log), "--log " + o.log + ": cannot write");
-    }
-    if (o.noise_study > 0) return noise_study(pb, log);
-    return tune(pb, log.is_open() ? &log : nullptr);
+    // Emptied (an existing log replaced) only now: an interrupted calibration leaves it as it was.
+    if (log.is_open()) log.truncate();
+    if (o.noise_study > 0) return noise_study(pb, log.stream());
+    return tune(pb, log.is_open() ? &log.stream() : nullptr);
   });
 }

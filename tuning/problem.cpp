@@ -12,6 +12,7 @@
 #include "cli/common.hpp"
 #include "json_io.hpp"
 #include "leeway/file_io.hpp"
+#include "leeway/mjcf_source.hpp"
 #include "tuner.hpp"
 
 namespace leeway::tune_cli {
@@ -237,20 +238,14 @@ void load(Problem& pb) {
     pb.noise_center = pb.checked_point(center, "--noise-center " + o.noise_center, "");
   }
 
-  // Output files: fail now rather than after the search.
-  for (const auto& [file, flag] : {std::pair{o.out, "--out"}, {o.report, "--report"}, {o.log, "--log"}}) {
-    if (file.empty()) continue;
-    const auto dir = std::filesystem::absolute(file).parent_path();
-    require(std::filesystem::is_directory(dir),
-            std::string(flag) + " " + file + ": the directory " + dir.string() + " does not exist");
-    std::vector<std::string> inputs = {o.params, o.noise_center};
-    for (const auto& text : o.cases) inputs.push_back(leeway::parse_case(text).cell);
-    try {
-      leeway::require_regular_output(file, inputs);
-    } catch (const InputError& e) {
-      throw InputError(std::string(flag) + " " + e.what());
-    }
+  // Output files: fail now rather than after the search. None may replace a file the run reads (a
+  // case's cell with its includes and meshes, the parameter files), nor another output.
+  std::vector<std::string> inputs = {o.params, o.noise_center};
+  for (const auto& text : o.cases) {
+    const std::vector<std::string> cell = leeway::model_input_files(leeway::parse_case(text).cell);
+    inputs.insert(inputs.end(), cell.begin(), cell.end());
   }
+  leeway::require_outputs({{o.out, "--out", {}}, {o.report, "--report", {}}, {o.log, "--log", {}}}, inputs);
 
   pb.report["command"] = pb.command;
   pb.report["machine"] = {{"cpu", cpu_model()}, {"hardware_threads", std::thread::hardware_concurrency()}};

@@ -39,8 +39,10 @@ std::vector<std::string> take_mujoco_warnings();
 //! warnings; leeway calls this before every mj_collision.
 void prevent_contact_warnings(mjData& d);
 
-//! Compiles an MJCF (or MJB) file.
-//! @throws InputError naming the file when it is missing, unreadable or does not compile.
+//! Compiles an MJCF (or MJB) file; an MJCF file's numeric attributes, included files' too, are
+//! checked first (read_mjcf_source).
+//! @throws InputError naming the file when it is missing, unreadable or does not compile, or naming
+//! the file, element, attribute and value of a number that is not finite.
 ModelPtr load_model_file(const std::string& path);
 
 //! Compiles MJCF text as if it were the file `virtual_path` (through MuJoCo's virtual file system),

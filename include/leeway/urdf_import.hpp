@@ -56,6 +56,9 @@ struct UrdfImport {
   //! What the import changed or approximated beyond the one-box-per-element rule (frozen joints,
   //! thin boxes, a skipped world link), one line each; also written as comments in `mjcf`.
   std::vector<std::string> notes;
+  //! The files the import read: the URDF, then each mesh file (as resolved), for refusing an output
+  //! that would replace one of them.
+  std::vector<std::string> inputs;
 };
 
 //! An import that one of UrdfImportOptions' fields would let through (a continuous joint, a

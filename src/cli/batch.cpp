@@ -12,6 +12,7 @@
 #include "dist.hpp"
 #include "leeway/batch.hpp"
 #include "leeway/file_io.hpp"
+#include "leeway/mjcf_source.hpp"
 
 namespace leeway::cli {
 namespace {
@@ -81,8 +82,17 @@ int run_batch(const BatchArgs& args) {
     throw InputError("--threads " + std::to_string(args.threads) + " must be >= 1 (or 0: the default)");
   // Everything is checked before the first scenario runs.
   const Suite suite = read_suite(args.suite);
-  if (!args.junit.empty()) require_output(args.junit, "--junit", {".xml"});
-  if (!args.out.empty()) require_output(args.out, "--out", {".json"});
+  // No report may replace the suite or a file a scenario reads (its cell with the cell's includes
+  // and meshes, its path and parameter files), nor the other report.
+  std::vector<std::string> inputs = {args.suite};
+  for (const auto& s : suite.scenarios) {
+    const json& run = s.resolved.at("run");
+    const std::vector<std::string> cell = model_input_files(run.at("cell").get<std::string>());
+    inputs.insert(inputs.end(), cell.begin(), cell.end());
+    for (const char* key : {"path", "params"})
+      if (run.contains(key) && run[key].is_string()) inputs.push_back(run[key].get<std::string>());
+  }
+  require_outputs({{args.junit, "--junit", {".xml"}}, {args.out, "--out", {".json"}}}, inputs);
   const size_t n = suite.scenarios.size();
   std::cout << "suite " << suite.name << ": " << n << " scenario" << (n == 1 ? "" : "s") << " on "
             << pool->size() << " rank" << (pool->size() == 1 ? "" : "s") << " x " << threads << " thread"

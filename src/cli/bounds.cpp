@@ -10,6 +10,7 @@
 #include "leeway/endpoints.hpp"
 #include "leeway/export_mjcf.hpp"
 #include "leeway/file_io.hpp"
+#include "leeway/mjcf_source.hpp"
 #include "leeway/nominal_path.hpp"
 #include "leeway/path_check.hpp"
 #include "leeway/pipeline.hpp"
@@ -113,12 +114,14 @@ int run_bounds(const BoundsArgs& args) {
   if (args.max_cells_given) p.height_map.max_cells = args.max_cells;
   p.validate();
   require_threads(args.threads);
-  const std::vector<std::string> inputs = {args.cell, args.params, args.path};
-  if (!args.out.empty()) require_output(args.out, "--out", {}, inputs);
-  if (!args.export_mjcf.empty()) require_output(args.export_mjcf, "--export-mjcf", {".xml"}, inputs);
-  if (!args.export_mjb.empty()) require_output(args.export_mjb, "--export-mjb", {".mjb"}, inputs);
-  require_distinct_outputs(
-      {{args.out, "--out"}, {args.export_mjcf, "--export-mjcf"}, {args.export_mjb, "--export-mjb"}});
+  // No output may replace a file the run reads: the cell, its includes and meshes, the parameter
+  // and path files.
+  std::vector<std::string> inputs = model_input_files(args.cell);
+  inputs.insert(inputs.end(), {args.params, args.path});
+  require_outputs({{args.out, "--out", {}},
+                   {args.export_mjcf, "--export-mjcf", {".xml"}},
+                   {args.export_mjb, "--export-mjb", {".mjb"}}},
+                  inputs);
   std::vector<Eigen::VectorXd> path;
   std::string label = args.from + " -> " + args.to;
   const bool linear = args.path.empty() && !is_gripper_goal(args.from) && !is_gripper_goal(args.to);

@@ -110,44 +110,6 @@ bool plan_between(const Scene& scene, const std::string& from, const std::string
   return true;
 }
 
-void require_output(const std::string& path, const std::string& flag,
-                    const std::vector<std::string>& extensions, const std::vector<std::string>& inputs) {
-  namespace fs = std::filesystem;
-  if (path.empty()) throw InputError(flag + ": the output file name is empty");
-  if (!extensions.empty()) {
-    const std::string ext = fs::path(path).extension().string();
-    if (std::find(extensions.begin(), extensions.end(), ext) == extensions.end()) {
-      std::string listed;
-      for (const auto& e : extensions) listed += (listed.empty() ? "" : " or ") + e;
-      throw InputError(flag + " " + path + ": the file name must end in " + listed);
-    }
-  }
-  const fs::path folder = fs::path(path).has_parent_path() ? fs::path(path).parent_path() : fs::path(".");
-  std::error_code ec;
-  if (!fs::is_directory(folder, ec) || ::access(folder.c_str(), W_OK) != 0)
-    throw InputError(flag + " " + path + ": cannot write there (folder '" + folder.string() +
-                     "' missing or not writable)");
-  if (fs::is_directory(path, ec)) throw InputError(flag + " " + path + ": is a folder, not a file");
-  try {
-    require_regular_output(path, inputs);
-  } catch (const InputError& e) {
-    throw InputError(flag + " " + e.what());
-  }
-}
-
-void require_distinct_outputs(const std::vector<std::pair<std::string, std::string>>& outputs) {
-  namespace fs = std::filesystem;
-  for (size_t i = 0; i < outputs.size(); ++i)
-    for (size_t k = i + 1; k < outputs.size(); ++k) {
-      const auto& [a, fa] = outputs[i];
-      const auto& [b, fb] = outputs[k];
-      if (a.empty() || b.empty()) continue;
-      std::error_code ec;
-      if (fs::weakly_canonical(a, ec) == fs::weakly_canonical(b, ec))
-        throw InputError(fa + " and " + fb + " name the same file " + a);
-    }
-}
-
 void require_threads(int threads, const std::string& flag) {
   if (threads < 1 || threads > kMaxThreads)
     throw InputError(flag + " " + std::to_string(threads) + " must be from 1 to " +

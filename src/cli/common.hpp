@@ -209,19 +209,6 @@ bool plan_between(const Scene& scene, const std::string& from, const std::string
                   const std::string& ik_seed_key, const PlanOptions& options, PlanResult& result, Endpoint& a,
                   Endpoint& b);
 
-//! Checks, before any work, that an output file can be written: its folder exists and is writable,
-//! it is not an existing folder, FIFO, device or other non-regular file, it is none of `inputs`
-//! (the same file by std::filesystem::equivalent) and, when `extensions` is not empty, its name ends
-//! in one of them (".png"). `flag` names the option.
-//! @throws InputError naming the flag and the path otherwise.
-void require_output(const std::string& path, const std::string& flag,
-                    const std::vector<std::string>& extensions = {},
-                    const std::vector<std::string>& inputs = {});
-
-//! Refuses two of `outputs` (path, flag; empty paths skipped) that name the same file.
-//! @throws InputError naming both flags.
-void require_distinct_outputs(const std::vector<std::pair<std::string, std::string>>& outputs);
-
 //! Parses an image size "WIDTHxHEIGHT" [pixels]. @throws InputError naming `flag` and the value.
 std::pair<int, int> parse_size(const std::string& text, const std::string& flag);
 

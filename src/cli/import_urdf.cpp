@@ -34,10 +34,13 @@ CLI::App* add_import_urdf(CLI::App& app, ImportUrdfArgs& args) {
 }
 
 int run_import_urdf(const ImportUrdfArgs& args) {
-  require_output(args.out, "--out", {}, {args.urdf, args.srdf});
   // The excludes fragment goes beside the robot fragment, where new-cell looks for it.
   const std::string excludes = excludes_path(args.out);
-  require_output(excludes, "--out (its excludes fragment)", {}, {args.urdf, args.srdf});
+  std::vector<std::string> read = {args.urdf};
+  if (!args.srdf.empty()) read.push_back(args.srdf);
+  const std::vector<OutputFile> outputs = {{args.out, "--out", {}},
+                                           {excludes, "--out (its excludes fragment)", {}}};
+  require_outputs(outputs, read);
   UrdfImportOptions options;
   options.package_paths = args.package_paths;
   if (const char* env = std::getenv("ROS_PACKAGE_PATH")) options.ros_package_path = env;
@@ -56,6 +59,9 @@ int run_import_urdf(const ImportUrdfArgs& args) {
                                                          : "--base-link LINK";
     throw InputError(std::string(e.what()) + " (see " + flag + ")");
   }
+  // The meshes the URDF names are known once it is read: the outputs may replace none of them.
+  read.insert(read.end(), robot.inputs.begin(), robot.inputs.end());
+  require_outputs(outputs, read);
   write_file_atomic(excludes, robot.excludes_mjcf);
   write_file_atomic(args.out, robot.mjcf);
   std::cout << "wrote " << args.out << ": robot '" << robot.robot_name << "', " << robot.joints.size()

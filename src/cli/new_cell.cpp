@@ -5,6 +5,7 @@
 
 #include "cli/common.hpp"
 #include "leeway/error.hpp"
+#include "leeway/file_io.hpp"
 #include "leeway/new_cell.hpp"
 
 namespace leeway::cli {
@@ -26,7 +27,11 @@ CLI::App* add_new_cell(CLI::App& app, NewCellArgs& args) {
 }
 
 int run_new_cell(const NewCellArgs& args) {
-  require_output(args.out, "--out", {}, {args.robot, args.excludes});
+  // The files the robot includes and its meshes are checked by write_new_cell, resolved from the
+  // cell's folder as MuJoCo will.
+  std::vector<std::string> read = {args.robot};
+  if (!args.excludes.empty()) read.push_back(args.excludes);
+  require_outputs({{args.out, "--out", {}}}, read);
   const std::string name = args.name.empty() ? std::filesystem::path(args.out).stem().string() : args.name;
   const NewCell cell = write_new_cell(args.robot, args.out, name, args.excludes);
   std::cout << "wrote " << args.out << ": includes " << cell.robot_include

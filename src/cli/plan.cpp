@@ -5,6 +5,7 @@
 
 #include "leeway/endpoints.hpp"
 #include "leeway/file_io.hpp"
+#include "leeway/mjcf_source.hpp"
 #include "leeway/nominal_path.hpp"
 #include "leeway/planner.hpp"
 
@@ -52,7 +53,7 @@ CLI::App* add_plan(CLI::App& app, PlanArgs& args) {
 
 int run_plan(const PlanArgs& args) {
   const auto scene = Scene::load(args.cell, scene_options(args.tool, args.checker));
-  if (!args.out.empty()) require_output(args.out, "--out", {}, {args.cell});
+  require_outputs({{args.out, "--out", {}}}, model_input_files(args.cell));
   PlanOptions options = args.options;
   options.simplify = !args.no_simplify;
   options.try_direct = !args.no_direct;

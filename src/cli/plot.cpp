@@ -66,7 +66,7 @@ int plot_sweeps(const PlotArgs& args, int width, int height) {
 }  // namespace
 
 int run_plot(const PlotArgs& args) {
-  require_output(args.out, "--out", {".svg", ".png"}, args.inputs);
+  require_outputs({{args.out, "--out", {".svg", ".png"}}}, args.inputs);
   int width = 0, height = 0;
   if (!args.size.empty()) std::tie(width, height) = parse_size(args.size, "--size");
   const bool csv = is_csv(args.inputs.front());

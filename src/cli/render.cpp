@@ -3,6 +3,8 @@
 #include <cmath>
 #include <iostream>
 
+#include "leeway/file_io.hpp"
+#include "leeway/mjcf_source.hpp"
 #include "leeway/nominal_path.hpp"
 #include "leeway/path_check.hpp"
 #include "leeway/pipeline.hpp"
@@ -68,7 +70,9 @@ CLI::App* add_render(CLI::App& app, RenderArgs& args) {
 
 int run_render(const RenderArgs& args) {
   // Every flag is checked before any work, so that bad input writes nothing.
-  require_output(args.out, "--out", {".png"}, {args.cell, args.bounds, args.params});
+  std::vector<std::string> inputs = model_input_files(args.cell);
+  inputs.insert(inputs.end(), {args.bounds, args.params});
+  require_outputs({{args.out, "--out", {".png"}}}, inputs);
   const auto [width, height] = parse_size(args.size, "--size");
   if (args.volume != "on" && args.volume != "off")
     throw InputError("--volume '" + args.volume + "' must be on or off");

@@ -11,6 +11,7 @@
 
 #include "cli/plot.hpp"
 #include "leeway/file_io.hpp"
+#include "leeway/mjcf_source.hpp"
 #include "leeway/nominal_path.hpp"
 #include "leeway/path_check.hpp"
 #include "leeway/pipeline.hpp"
@@ -96,11 +97,13 @@ int run_sweep(const SweepArgs& args) {
     require_memory(args.waypoints * kBytesPerWaypoint, "--waypoints " + std::to_string(args.waypoints));
   if (cf.windows >= 1)
     require_memory(cf.windows * kBytesPerWindow, "CF windows " + std::to_string(cf.windows));
-  const std::vector<std::string> inputs = {args.cell, args.params};
-  if (!args.plot.empty()) require_output(args.plot, "--plot", {".svg", ".png"}, inputs);
-  if (!args.csv.empty()) require_output(args.csv, "--csv", {}, inputs);
-  if (!args.csv.empty() && !args.plot.empty() && std::filesystem::path(args.csv) == args.plot)
-    throw InputError("--csv and --plot name the same file " + args.csv);
+  std::vector<std::string> inputs = model_input_files(args.cell);
+  inputs.push_back(args.params);
+  require_outputs({{args.plot, "--plot", {".svg", ".png"}}, {args.csv, "--csv", {}}}, inputs);
+  // Rows are written as they finish (standard output and --csv, flushed), so that an interrupted
+  // sweep keeps the rows it finished; the CSV is locked now, its old content kept until the first row.
+  StreamingOutput csv_file;
+  if (!args.csv.empty()) csv_file = StreamingOutput(args.csv, "--csv");
   require_threads(args.threads);
   const auto path = keyframe_path(scene, args.from, args.to, args.waypoints);
   // Issue #9: the nominal path is checked first; a sweep bounds the straight path only.
@@ -118,23 +121,16 @@ int run_sweep(const SweepArgs& args) {
   }
   VolumeModel world(
       scene, *std::max_element(cells.begin(), cells.end()) + static_cast<int>(scene.obstacle_geoms().size()));
-  // Rows are written as they finish (standard output and --csv, flushed), so that an interrupted
-  // sweep keeps the rows it finished.
-  std::ofstream csv;
-  if (!args.csv.empty()) {
-    csv.open(args.csv, std::ios::trunc);
-    if (!csv) throw InputError("--csv " + args.csv + ": cannot write the file");
-  }
-  auto flush_csv = [&] {
-    csv.flush();
-    if (!csv) throw InputError("--csv " + args.csv + ": writing the file failed");
-  };
+  if (csv_file.is_open()) csv_file.truncate();
+  std::ostringstream no_csv;
+  std::ostream& csv = csv_file.is_open() ? csv_file.stream() : no_csv;
+  auto flush_csv = [&] { csv.flush(); };  // a failed write throws, naming the file
   std::ostream& md = std::cout;
   md << "| Max CBox | CBox | Computational Time [ms] | Confidence Factor [%] | 95 % CI [%] |"
         " worst window [%] | collapsed | mean width j1-j3 [rad] |\n"
      << "|---:|---:|---:|---:|---|---:|---:|---:|\n";
   md.flush();
-  if (csv.is_open()) {
+  if (csv_file.is_open()) {
     csv << "max_cells,boxes,time_ms,volume_ms,bounds_ms,checks,cf,ci_low,ci_high,worst_window_cf,collapsed,"
            "mean_width\n";
     flush_csv();
@@ -155,7 +151,7 @@ int run_sweep(const SweepArgs& args) {
        << 100 * r.ci_high << " | " << 100 * r.worst_window_cf << " | " << collapsed << "/" << bisected
        << " | " << std::setprecision(3) << width << " |\n";
     md.flush();
-    if (csv.is_open()) {
+    if (csv_file.is_open()) {
       csv << c << "," << run.volume.boxes.size() << "," << std::setprecision(3) << run.ms_total() << ","
           << run.ms_volume << "," << run.ms_bounds << "," << run.checks << "," << std::setprecision(6) << r.cf
           << "," << r.ci_low << "," << r.ci_high << "," << r.worst_window_cf << "," << collapsed << ","

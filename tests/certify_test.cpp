@@ -75,6 +75,10 @@ int property_count(int fallback) {
   const char* env = std::getenv("LEEWAY_CERTIFY_COUNT");
   return env ? std::stoi(env) : fallback;
 }
+// Whether a property test drew enough regions for its statements that it is not vacuous (so many
+// certified, so many near an obstacle) to be expected: the sanitizer builds draw a tenth of the
+// regions (LEEWAY_CERTIFY_COUNT=40, scripts/sanitize.sh) to run every code path, not to sample.
+bool sampled_enough(int count) { return count >= 50; }
 
 // Random joint boxes of one cell: centres uniform within the limits, close to an obstacle (exact
 // clearance in (0, 0.1) m, by rejection) or near a keyframe; half-widths uniform in [0, s] per joint
@@ -368,8 +372,10 @@ TEST_P(CertifyPropertyTest, CertifiedRegionsAreFree) {
   }
   std::cout << "[ certify  ] " << cell << ": " << certified << " of " << count << " regions certified ("
             << close << " within 5 cm of the margin), " << leaves << " leaves\n";
-  EXPECT_GT(certified, count / 10) << "the property is nearly vacuous";
-  EXPECT_GT(close, 0) << "no certified region came near an obstacle";
+  if (sampled_enough(count)) {
+    EXPECT_GT(certified, count / 10) << "the property is nearly vacuous";
+    EXPECT_GT(close, 0) << "no certified region came near an obstacle";
+  }
 }
 
 // The sharpest form of the property: boxes grown until the certificate just fails. From a free
@@ -422,8 +428,10 @@ TEST_P(CertifyPropertyTest, LargestCertifiedBoxesAreFree) {
   }
   std::cout << "[ certify  ] " << cell << ": " << boxes << " largest certified boxes (" << close
             << " within 1 cm of the margin)\n";
-  EXPECT_GT(boxes, count / 4) << "the property is nearly vacuous";
-  EXPECT_GT(close, boxes / 10) << "the largest certified boxes stay far from the obstacles";
+  if (sampled_enough(count)) {
+    EXPECT_GT(boxes, count / 4) << "the property is nearly vacuous";
+    EXPECT_GT(close, boxes / 10) << "the largest certified boxes stay far from the obstacles";
+  }
 }
 
 // The same for segment_free: two random boxes (the second centred up to 0.3 rad or m per joint
@@ -462,8 +470,10 @@ TEST_P(CertifyPropertyTest, CertifiedSegmentsAreFree) {
   }
   std::cout << "[ certify  ] " << cell << ": " << certified << " of " << count << " segments certified ("
             << close << " within 5 cm of the margin), " << leaves << " leaves\n";
-  EXPECT_GT(certified, count / 10) << "the property is nearly vacuous";
-  EXPECT_GT(close, 0) << "no certified segment came near an obstacle";
+  if (sampled_enough(count)) {
+    EXPECT_GT(certified, count / 10) << "the property is nearly vacuous";
+    EXPECT_GT(close, 0) << "no certified segment came near an obstacle";
+  }
 }
 
 // A slab that grows a certified box in one joint (the safety stage's regrow step) is proven with
@@ -504,8 +514,10 @@ TEST_P(CertifyPropertyTest, GrownSlabsOfCertifiedBoxesAreFree) {
   }
   std::cout << "[ certify  ] " << cell_ << ": " << slabs << " grown slabs certified (" << close
             << " within 5 cm of the margin)\n";
-  EXPECT_GT(slabs, count / 20) << "the property is nearly vacuous";
-  EXPECT_GT(close, 0) << "no certified slab came near an obstacle";
+  if (sampled_enough(count)) {
+    EXPECT_GT(slabs, count / 20) << "the property is nearly vacuous";
+    EXPECT_GT(close, 0) << "no certified slab came near an obstacle";
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(CertifyCells, CertifyPropertyTest,

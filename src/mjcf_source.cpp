@@ -321,7 +321,13 @@ struct Reader {
         std::error_code ec;
         if (!fs::exists(path, ec)) continue;  // MuJoCo names the missing file
         // A FIFO would block MuJoCo's reader, as a FIFO given as the cell would.
-        require_regular_input(path.string(), "included file");
+        try {
+          require_regular_input(path.string(), "included file");
+        } catch (const InputError& err) {
+          // The message names the included path; the file to mend is the one that includes it.
+          throw InputError(file + ": include '" + *name + "' (line " + std::to_string(e.line) +
+                           "): " + err.what());
+        }
         if (!seen.insert(fs::weakly_canonical(path, ec).string()).second) continue;  // MuJoCo's error
         read(path.string(), depth + 1);
       }

@@ -121,6 +121,18 @@ TEST_F(MjcfSourceTest, IncludedFilesAreCheckedAndNamedInTheMessage) {
               HasSubstr(path("cells") + "/../robots/part.xml: geom 'p' pos '0 0 -inf' is not finite"));
 }
 
+// An include that names a folder is refused with the including file, the include and the line: the
+// file to mend is the one that includes it.
+TEST_F(MjcfSourceTest, AnIncludeNamingAFolderNamesTheIncludingFile) {
+  fs::create_directories(dir_.path() / "cells");
+  fs::create_directories(dir_.path() / "robots");
+  const std::string cell = dir_.write(
+      "cells/cell.xml", "<mujoco>\n<worldbody>\n<include file=\"../robots\"/></worldbody></mujoco>");
+  EXPECT_EQ(error_of([&] { read_mjcf_source(cell); }),
+            cell + ": include '../robots' (line 3): " + path("cells") +
+                "/../robots: the included file is a folder, not a regular file");
+}
+
 // A deeply nested file is refused (or left to MuJoCo) without exhausting the stack.
 TEST_F(MjcfSourceTest, DeepNestingIsASyntaxErrorNotACrash) {
   std::string text = "<mujoco><worldbody>";

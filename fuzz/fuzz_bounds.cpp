@@ -6,8 +6,10 @@
 // mismatch: unreadable file or malformed JSON (as read_params), not a bounds file, another
 // "format", other joints, wrong sizes or types (nlohmann's type errors are turned into InputError
 // "unexpected content"), bounds outside the limits, a nominal outside its bounds, an unknown
-// collapsed joint. Anything else is a finding: another exception, a crash, a sanitizer report, a
-// leak, a timeout, or a result that breaks the guarantees above.
+// collapsed joint; read_bounds_trajectory also refuses format-2 times that are missing, not finite,
+// not starting at 0, decreasing, or an s other than the index, and its trajectory's box at any s
+// contains the nominal value there. Anything else is a finding: another exception, a crash, a sanitizer
+// report, a leak, a timeout, or a result that breaks the guarantees above.
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -36,6 +38,20 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       }
       if (!ok) {
         std::fprintf(stderr, "leeway fuzz: read_bounds returned bounds outside its guarantees\n");
+        std::abort();
+      }
+    }
+  } catch (const leeway::InputError& e) {
+    leeway::fuzz::require_names_file(e, path);
+  }
+  try {
+    const leeway::BoundsTrajectory tr = leeway::read_bounds_trajectory(path, scene);
+    for (double s : {0.0, 0.5 * tr.s_end(), 0.37 * tr.s_end(), tr.s_end()}) {
+      const leeway::BoundsStage b = tr.at_s(s);
+      if (!((b.lower.array() <= b.nominal.array()).all() && (b.nominal.array() <= b.upper.array()).all()) ||
+          !(tr.t_at_s(s) >= 0 && tr.t_at_s(s) <= tr.duration())) {
+        std::fprintf(stderr, "leeway fuzz: a trajectory box at s = %g leaves out its nominal value or time\n",
+                     s);
         std::abort();
       }
     }

@@ -1,11 +1,48 @@
 #include "leeway/bounds_file.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "json_io.hpp"
+#include "leeway/confidence.hpp"
 #include "leeway/error.hpp"
 
 namespace leeway {
+
+bool is_bounds_format(const nlohmann::json& format) {
+  return format == nlohmann::json(kBoundsFormat) || format == nlohmann::json(kBoundsFormat1);
+}
+
+namespace {
+
+// What the bounds promise, as data: the region proven free (certified mode) or that nothing is
+// proven (sampled or none), and what a proof never covers.
+nlohmann::json certified_region_json(const Scene& scene, const SafetyReport& report,
+                                     const SafetyParams& params) {
+  using nlohmann::json;
+  json out = {{"mode", safety_mode_name(report.mode)}};
+  if (report.mode != SafetyMode::kCertified) {
+    out["proven"] = false;
+    out["set"] = report.mode == SafetyMode::kSampled
+                     ? "each segment passed a sampled test (safety.epsilon, safety.delta): not a proof"
+                     : "nothing checked beyond the volume of boxes (the thesis's method)";
+    return out;
+  }
+  out["proven"] = report.all_passed;
+  out["set"] =
+      "every q with lower(s) <= q <= upper(s), joint by joint, at every path parameter s in [0, N - 1] "
+      "(bounds linear in s between waypoints)";
+  out["margin"] = params.margin;
+  out["pairs"] = {"link_obstacle", "self"};
+  out["excluded_pairs"] = scene.excluded_pairs().size();
+  out["not_covered"] = {
+      "pairs the cell excludes (safety.pairs.excluded)",
+      "pairs on one rigid part or on a parent and its child", "geometry beyond each geom's box",
+      "dynamics: what a controller does between its own samples of s", "any q outside the bounds at its s"};
+  return out;
+}
+
+}  // namespace
 
 nlohmann::json safety_json(const Scene& scene, const SafetyReport& report, const SafetyParams& params) {
   using nlohmann::json;
@@ -52,7 +89,7 @@ nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Param
   using nlohmann::json;
   json out;
   out["format"] = kBoundsFormat;
-  out["units"] = "SI: metres, radians, milliseconds";
+  out["units"] = "SI: metres, radians, seconds (timing_ms in milliseconds, speeds in rad/s or m/s)";
   out["cell"] = scene.source();
   out["joints"] = scene.joint_names();
   json kinds = json::array();
@@ -61,8 +98,25 @@ nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Param
                     : k == BoundKind::kFixed  ? "fixed"
                                               : "linear_axis");
   out["joint_bounding"] = kinds;
+  const PathTiming timing = time_path(scene, run.bounds);
+  json speeds = json::array();
+  for (const auto& j : scene.joints()) speeds.push_back(j.max_speed);
+  out["timing"] = {
+      {"timed", timing.timed},
+      {"duration", timing.total},
+      {"joint_speeds", speeds},
+      {"rule", timing.timed ? "each segment lasts as long as its slowest joint needs at its speed: "
+                              "max over joints of |q_j(b) - q_j(a)| / speed_j"
+                            : "a joint has no speed (0): each segment lasts 1 and t = s"}};
+  out["interpolation"] = {
+      {"parameter", "s"},
+      {"waypoint_s", "the waypoint's index: s = i at waypoint i, s = i + f a fraction f of the way to i + 1"},
+      {"between_waypoints", "linear in s, joint by joint, for q, lower and upper"},
+      {"time", "t linear in s within each segment; the guarantee is in s, not in t"}};
+  out["certified_region"] = certified_region_json(scene, run.safety, params.safety);
   json wps = json::array();
-  for (const auto& w : run.bounds) {
+  for (size_t wi = 0; wi < run.bounds.size(); ++wi) {
+    const WaypointBounds& w = run.bounds[wi];
     json collapsed = json::array();
     for (size_t i = 0; i < w.collapsed.size(); ++i)
       if (w.collapsed[i]) collapsed.push_back(scene.joints()[i].name);
@@ -73,7 +127,9 @@ nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Param
       if (below > 0 || above > 0)
         shrunk[scene.joints()[static_cast<size_t>(i)].name] = {{"lower_by", below}, {"upper_by", above}};
     }
-    wps.push_back({{"q", detail::to_json_array(w.q)},
+    wps.push_back({{"t", timing.segment_start[wi]},
+                   {"s", static_cast<double>(wi)},
+                   {"q", detail::to_json_array(w.q)},
                    {"lower", detail::to_json_array(w.lower)},
                    {"upper", detail::to_json_array(w.upper)},
                    {"collapsed", collapsed},
@@ -104,21 +160,27 @@ nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Param
   return out;
 }
 
-std::vector<WaypointBounds> read_bounds(const std::string& path, const Scene& scene) {
-  const nlohmann::json j = detail::read_json_file(path, "bounds file");
+namespace {
+
+// The waypoints of a bounds file; with a scene, checked against its robot (joint names and limits).
+std::vector<WaypointBounds> bounds_from_json(const nlohmann::json& j, const std::string& path,
+                                             const Scene* scene) {
   auto fail = [&](const std::string& what) { throw InputError(path + ": " + what); };
   try {
     if (!j.is_object() || !j.contains("joints") || !j.contains("waypoints"))
       fail("not a leeway bounds file (needs 'joints' and 'waypoints')");
     // Older files have no 'format'; one that names another format is not ours to guess at.
-    if (j.contains("format") && j.at("format") != nlohmann::json(kBoundsFormat))
-      fail("format " + j.at("format").dump() + " is not a leeway bounds file (" + kBoundsFormat + ")");
+    if (j.contains("format") && !is_bounds_format(j.at("format")))
+      fail("format " + j.at("format").dump() + " is not a leeway bounds file (" + kBoundsFormat + " or " +
+           kBoundsFormat1 + ")");
     const auto names = j.at("joints").get<std::vector<std::string>>();
-    if (names != scene.joint_names()) {
+    if (names.empty()) fail("'joints' is empty");
+    if (scene && names != scene->joint_names()) {
       std::string listed;
       for (const auto& n : names) listed += (listed.empty() ? "" : " ") + n;
-      fail("its joints '" + listed + "' do not match the robot in " + scene.source());
+      fail("its joints '" + listed + "' do not match the robot in " + scene->source());
     }
+    const int dof = static_cast<int>(names.size());
     std::vector<WaypointBounds> out;
     const auto& wps = j.at("waypoints");
     if (!wps.is_array() || wps.empty()) fail("'waypoints' must be a non-empty list");
@@ -127,26 +189,26 @@ std::vector<WaypointBounds> read_bounds(const std::string& path, const Scene& sc
       const std::string where = "waypoint " + std::to_string(i);
       for (const char* key : {"q", "lower", "upper"}) {
         const auto values = wps[i].at(key).get<std::vector<double>>();
-        if (static_cast<int>(values.size()) != scene.dof())
+        if (static_cast<int>(values.size()) != dof)
           fail(where + " '" + key + "' has " + std::to_string(values.size()) + " values, the robot has " +
-               std::to_string(scene.dof()) + " joints");
-        Eigen::VectorXd v = Eigen::Map<const Eigen::VectorXd>(values.data(), scene.dof());
+               std::to_string(dof) + " joints");
+        Eigen::VectorXd v = Eigen::Map<const Eigen::VectorXd>(values.data(), dof);
         if (std::string(key) == "q") w.q = v;
         if (std::string(key) == "lower") w.lower = v;
         if (std::string(key) == "upper") w.upper = v;
       }
-      for (int k = 0; k < scene.dof(); ++k) {
-        const auto& joint = scene.joints()[static_cast<size_t>(k)];
+      for (int k = 0; scene && k < dof; ++k) {
+        const auto& joint = scene->joints()[static_cast<size_t>(k)];
         if (!(w.lower[k] >= joint.lower && w.upper[k] <= joint.upper))
           fail(where + " joint '" + joint.name + "': bounds [" + format_number(w.lower[k]) + ", " +
                format_number(w.upper[k]) + "] leave its limits [" + format_number(joint.lower) + ", " +
                format_number(joint.upper) + "]");
       }
-      for (int k = 0; k < scene.dof(); ++k)
+      for (int k = 0; k < dof; ++k)
         if (!(w.lower[k] <= w.q[k] && w.q[k] <= w.upper[k]))
           fail(where + " joint '" + names[static_cast<size_t>(k)] + "': nominal " + format_number(w.q[k]) +
                " is not within [" + format_number(w.lower[k]) + ", " + format_number(w.upper[k]) + "]");
-      w.collapsed.assign(static_cast<size_t>(scene.dof()), false);
+      w.collapsed.assign(static_cast<size_t>(dof), false);
       if (wps[i].contains("collapsed")) {
         // The names of the joints whose interval the collapse guard widened (bounds_json).
         for (const auto& name : wps[i].at("collapsed").get<std::vector<std::string>>()) {
@@ -161,6 +223,80 @@ std::vector<WaypointBounds> read_bounds(const std::string& path, const Scene& sc
   } catch (const nlohmann::json::exception& e) {
     throw InputError(path + ": unexpected content: " + e.what());
   }
+}
+
+// Format 2's times: one t per waypoint, from 0, non-decreasing; s equal to the index.
+std::vector<double> times_from_json(const nlohmann::json& j, const std::string& path) {
+  auto fail = [&](const std::string& what) { throw InputError(path + ": " + what); };
+  const auto& wps = j.at("waypoints");
+  std::vector<double> times;
+  times.reserve(wps.size());
+  try {
+    for (size_t i = 0; i < wps.size(); ++i) {
+      const std::string where = "waypoint " + std::to_string(i);
+      if (!wps[i].contains("t")) fail(where + " has no 't' (format " + std::string(kBoundsFormat) + ")");
+      const double t = wps[i].at("t").get<double>();
+      if (!std::isfinite(t) || (i == 0 && t != 0) || (i > 0 && t < times.back()))
+        fail(where + " 't' " + format_number(t) + " s: times start at 0 and never decrease");
+      if (wps[i].contains("s") && wps[i].at("s").get<double>() != static_cast<double>(i))
+        fail(where + " 's' " + format_number(wps[i].at("s").get<double>()) + " is not its index " +
+             std::to_string(i));
+      times.push_back(t);
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path + ": unexpected content: " + e.what());
+  }
+  return times;
+}
+
+}  // namespace
+
+std::vector<WaypointBounds> read_bounds(const std::string& path, const Scene& scene) {
+  return bounds_from_json(detail::read_json_file(path, "bounds file"), path, &scene);
+}
+
+namespace {
+
+// The trajectory of a parsed bounds file: format 2's own times, else (with a scene) the scene's.
+BoundsTrajectory trajectory_from_json(const nlohmann::json& j, const std::string& path, const Scene* scene) {
+  std::vector<WaypointBounds> bounds = bounds_from_json(j, path, scene);
+  if (j.value("format", std::string()) != kBoundsFormat) {
+    if (!scene)
+      throw InputError(path + ": a bounds file without times (format " + kBoundsFormat1 +
+                       " or older); give the cell to time it by its joint speeds, or write it again with "
+                       "leeway bounds");
+    return BoundsTrajectory(*scene, std::move(bounds));
+  }
+  std::vector<double> times = times_from_json(j, path);
+  bool timed = true;
+  try {
+    timed = !j.contains("timing") || j.at("timing").value("timed", true);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path + ": unexpected content: " + e.what());
+  }
+  try {
+    return BoundsTrajectory(std::move(bounds), std::move(times), timed);
+  } catch (const InputError& e) {
+    throw InputError(path + ": " + e.what());
+  }
+}
+
+}  // namespace
+
+BoundsTrajectory read_bounds_trajectory(const std::string& path, const Scene& scene) {
+  return trajectory_from_json(detail::read_json_file(path, "bounds file"), path, &scene);
+}
+
+BoundsFile read_bounds_file(const std::string& path) {
+  const nlohmann::json j = detail::read_json_file(path, "bounds file");
+  BoundsTrajectory trajectory = trajectory_from_json(j, path, nullptr);
+  std::string cell;
+  try {
+    cell = j.value("cell", std::string());
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path + ": 'cell' is not a file name: " + e.what());
+  }
+  return {j.at("joints").get<std::vector<std::string>>(), cell, std::move(trajectory)};
 }
 
 }  // namespace leeway

@@ -52,8 +52,6 @@ PathTiming time_path(const Scene& scene, const std::vector<WaypointBounds>& boun
 
 CfResult confidence_factor(const Scene& scene, const std::vector<WaypointBounds>& bounds,
                            const CfParams& params, int threads) {
-  if (params.windows < 1) throw InputError("CF windows " + std::to_string(params.windows) + " must be >= 1");
-  if (params.samples < 1) throw InputError("CF samples " + std::to_string(params.samples) + " must be >= 1");
   if (bounds.empty()) throw InputError("CF needs at least one bounded waypoint");
   require_joint_counts(scene, bounds);
   for (size_t i = 0; i < bounds.size(); ++i) {
@@ -61,15 +59,17 @@ CfResult confidence_factor(const Scene& scene, const std::vector<WaypointBounds>
     if (!b.lower.allFinite() || !b.upper.allFinite() || (b.lower.array() > b.upper.array()).any())
       throw InputError("bounds of waypoint " + std::to_string(i) + " are not finite or have lower > upper");
   }
-  const int segments = std::max<int>(1, static_cast<int>(bounds.size()) - 1);
-  const PathTiming timing = time_path(scene, bounds);
-  // Cumulative share of the path's duration at the start of every segment (and 1 at its end).
-  std::vector<double> start(static_cast<size_t>(segments) + 1, 1.0);
-  start[0] = 0.0;
-  for (int i = 1; i < segments; ++i)
-    start[static_cast<size_t>(i)] = timing.total > 0
-                                        ? timing.segment_start[static_cast<size_t>(i)] / timing.total
-                                        : static_cast<double>(i) / segments;
+  return confidence_factor(scene, BoundsTrajectory(scene, bounds), params, threads);
+}
+
+CfResult confidence_factor(const Scene& scene, const BoundsTrajectory& path, const CfParams& params,
+                           int threads) {
+  if (params.windows < 1) throw InputError("CF windows " + std::to_string(params.windows) + " must be >= 1");
+  if (params.samples < 1) throw InputError("CF samples " + std::to_string(params.samples) + " must be >= 1");
+  if (path.dof() != scene.dof())
+    throw InputError("bounds of " + std::to_string(path.dof()) + " joints for the robot of " +
+                     std::to_string(scene.dof()) + " in " + scene.source());
+  const std::vector<WaypointBounds>& bounds = path.waypoints();
   std::vector<long> free_count(static_cast<size_t>(params.windows), 0);
   std::vector<long> obstacle_count(static_cast<size_t>(params.windows), 0);
   std::vector<long> self_count(static_cast<size_t>(params.windows), 0);
@@ -85,13 +85,7 @@ CfResult confidence_factor(const Scene& scene, const std::vector<WaypointBounds>
         // A moment in window w (as a share of the path's duration), then its segment (the last
         // one starting at or before it: a segment of zero duration is never drawn) and the
         // position in it.
-        const double s = (w + unit(rng)) / params.windows;
-        const int seg = std::max(
-            0, static_cast<int>(std::upper_bound(start.begin(), start.end() - 1, s) - start.begin()) - 1);
-        const double span = start[static_cast<size_t>(seg) + 1] - start[static_cast<size_t>(seg)];
-        const double t = bounds.size() == 1 || span <= 0
-                             ? 0.0
-                             : std::min(1.0, (s - start[static_cast<size_t>(seg)]) / span);
+        const auto [seg, t] = path.locate_share((w + unit(rng)) / params.windows);
         const WaypointBounds& a = bounds[static_cast<size_t>(seg)];
         const WaypointBounds& b = bounds[std::min(bounds.size() - 1, static_cast<size_t>(seg) + 1)];
         detail::draw_in_segment(a.lower, a.upper, b.lower, b.upper, t, rng, q);
@@ -110,8 +104,8 @@ CfResult confidence_factor(const Scene& scene, const std::vector<WaypointBounds>
   });
 
   CfResult r;
-  r.duration = timing.total;
-  r.timed = timing.timed;
+  r.duration = path.duration();
+  r.timed = path.timed();
   long total_free = 0;
   r.worst_window_cf = 2;
   for (int w = 0; w < params.windows; ++w) {

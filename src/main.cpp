@@ -22,6 +22,7 @@
 #include "cli/plan.hpp"
 #include "cli/plot.hpp"
 #include "cli/render.hpp"
+#include "cli/sample.hpp"
 #include "cli/sweep.hpp"
 #include "leeway/error.hpp"
 #include "leeway/file_io.hpp"
@@ -42,6 +43,7 @@ int main(int argc, char** argv) {
   PlanArgs plan;
   BoundsArgs bounds;
   CfArgs cf;
+  SampleArgs sample;
   SweepArgs sweep;
   ParamsArgs params;
   ImportUrdfArgs import_urdf;
@@ -57,6 +59,7 @@ int main(int argc, char** argv) {
       {add_plan(app, plan), [&] { return run_plan(plan); }},
       {add_bounds(app, bounds), [&] { return run_bounds(bounds); }},
       {add_cf(app, cf), [&] { return run_cf(cf); }},
+      {add_sample(app, sample), [&] { return run_sample(sample); }},
       {add_sweep(app, sweep), [&] { return run_sweep(sweep); }},
       {add_params(app, params), [&] { return run_params(params); }},
       {add_import_urdf(app, import_urdf), [&] { return run_import_urdf(import_urdf); }},

@@ -78,8 +78,9 @@ std::vector<Eigen::VectorXd> read_path(const std::string& path, const Scene& sce
       fail("not a leeway path file (needs 'joints' and 'waypoints')");
     if (j.contains("format")) {
       const auto format = j.at("format").get<std::string>();
-      if (format != "leeway-path-1" && format != "leeway-bounds-1")
-        fail("format '" + format + "' is not a leeway path (leeway-path-1) or bounds file (leeway-bounds-1)");
+      if (format != "leeway-path-1" && format != "leeway-bounds-1" && format != "leeway-bounds-2")
+        fail("format '" + format +
+             "' is not a leeway path (leeway-path-1) or bounds file (leeway-bounds-1 or leeway-bounds-2)");
     }
     const auto names = j.at("joints").get<std::vector<std::string>>();
     if (names != scene.joint_names()) {

@@ -225,8 +225,9 @@ BoundsSeries read_bounds_series(const std::string& path) {
   try {
     if (!j.is_object() || !j.contains("joints") || !j.contains("waypoints"))
       fail("not a leeway bounds file (needs 'joints' and 'waypoints')");
-    if (j.contains("format") && j.at("format") != nlohmann::json(kBoundsFormat))
-      fail("format " + j.at("format").dump() + " is not a leeway bounds file (" + kBoundsFormat + ")");
+    if (j.contains("format") && !is_bounds_format(j.at("format")))
+      fail("format " + j.at("format").dump() + " is not a leeway bounds file (" + kBoundsFormat + " or " +
+           kBoundsFormat1 + ")");
     out.joints = j.at("joints").get<std::vector<std::string>>();
     const size_t dof = out.joints.size();
     if (dof == 0) fail("'joints' is empty");

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "leeway/bounds.hpp"
+#include "leeway/bounds_trajectory.hpp"
 #include "leeway/params.hpp"
 #include "leeway/pipeline.hpp"
 #include "leeway/safety.hpp"
@@ -19,8 +20,14 @@ namespace leeway {
 //! the pairs proven apart (link-obstacle and self pairs, counted) and the excluded pairs by name.
 nlohmann::json safety_json(const Scene& scene, const SafetyReport& report, const SafetyParams& params);
 
-//! The "format" value of the bounds files bounds_json writes and read_bounds accepts.
-inline constexpr const char* kBoundsFormat = "leeway-bounds-1";
+//! The "format" value of the bounds files bounds_json writes: format 2 adds each waypoint's time t
+//! and path parameter s, the joint speeds, and the interpolation rule and certified region as data.
+inline constexpr const char* kBoundsFormat = "leeway-bounds-2";
+//! The format before it (no times), still read.
+inline constexpr const char* kBoundsFormat1 = "leeway-bounds-1";
+
+//! True when `format` is a bounds file format leeway reads (kBoundsFormat or kBoundsFormat1).
+bool is_bounds_format(const nlohmann::json& format);
 
 //! The bounds file (docs/cli.md): joints, waypoints (q, lower, upper), boxes, max_cells, timing_ms...
 nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Params& params);
@@ -30,5 +37,23 @@ nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Param
 //! @throws InputError naming the file and the mismatch (a "format" other than kBoundsFormat, other
 //! joints, wrong sizes, NaN, lower > upper, nominal outside its bounds, an unknown collapsed joint).
 std::vector<WaypointBounds> read_bounds(const std::string& path, const Scene& scene);
+
+//! Reads a bounds file as a trajectory for `scene`: read_bounds(), then each waypoint's time from the
+//! file (format 2) or from the scene's joint speeds (format 1 and older, which have none).
+//! @throws InputError as read_bounds, and on a format-2 waypoint whose t is missing, not finite or
+//! before the previous one, or whose s is not its index.
+BoundsTrajectory read_bounds_trajectory(const std::string& path, const Scene& scene);
+
+//! A bounds file read without its cell: the joint names, the cell's file name as recorded, and the
+//! trajectory. Needs format 2 (its own times); the joint limits are not checked (no robot).
+struct BoundsFile {
+  std::vector<std::string> joints;
+  std::string cell;
+  BoundsTrajectory trajectory;
+};
+
+//! Reads a format-2 bounds file without its cell (BoundsFile).
+//! @throws InputError as read_bounds_trajectory, and on a file without times (format 1).
+BoundsFile read_bounds_file(const std::string& path);
 
 }  // namespace leeway

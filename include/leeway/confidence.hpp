@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "leeway/bounds.hpp"
+#include "leeway/bounds_trajectory.hpp"
 #include "leeway/params.hpp"
 #include "leeway/scene.hpp"
 
@@ -52,6 +53,12 @@ PathTiming time_path(const Scene& scene, const std::vector<WaypointBounds>& boun
 //! @throws InputError on fewer than 1 window or sample, or bounds that do not match the scene.
 CfResult confidence_factor(const Scene& scene, const std::vector<WaypointBounds>& bounds,
                            const CfParams& params, int threads);
+
+//! The Confidence Factor of a trajectory, with its own times (a bounds file's): the same draws as
+//! above, located by BoundsTrajectory::locate_share.
+//! @throws InputError on fewer than 1 window or sample, or bounds of another joint count.
+CfResult confidence_factor(const Scene& scene, const BoundsTrajectory& path, const CfParams& params,
+                           int threads);
 
 //! 95 % Wilson score interval of a binomial proportion (successes of n).
 std::pair<double, double> wilson_interval(long successes, long n);

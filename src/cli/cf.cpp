@@ -32,8 +32,9 @@ int run_cf(const CfArgs& args) {
   require_threads(args.threads);
   if (args.params.windows >= 1)
     require_memory(args.params.windows * kBytesPerWindow, "--windows " + std::to_string(args.params.windows));
-  const auto wb = read_bounds(args.bounds, scene);
-  const auto r = confidence_factor(scene, wb, args.params, args.threads);
+  // The file's own times (format 2), or the cell's timing (format 1).
+  const auto r =
+      confidence_factor(scene, read_bounds_trajectory(args.bounds, scene), args.params, args.threads);
   if (args.json) {
     nlohmann::json out = {
         {"cf", r.cf},

@@ -47,15 +47,32 @@ Eigen::VectorXd parse_vector(const std::string& text, const std::string& what) {
   std::vector<double> values;
   std::string token;
   std::vector<std::string> tokens;
+  // Commas separate values as spaces do, but an empty field between commas ("1,,2", a leading or
+  // trailing comma) is a mistake, not a value to skip.
+  bool field_has_value = false, comma = false;
+  auto empty_field = [&] { return InputError(what + ": '" + text + "' has an empty value between commas"); };
   for (char c : text) {
-    if (c == ',' || std::isspace(static_cast<unsigned char>(c))) {
-      if (!token.empty()) tokens.push_back(token);
+    const bool space = std::isspace(static_cast<unsigned char>(c));
+    if (c == ',' || space) {
+      if (!token.empty()) {
+        tokens.push_back(token);
+        field_has_value = true;
+      }
       token.clear();
+      if (c == ',') {
+        if (!field_has_value) throw empty_field();
+        field_has_value = false;
+        comma = true;
+      }
     } else {
       token += c;
     }
   }
-  if (!token.empty()) tokens.push_back(token);
+  if (!token.empty()) {
+    tokens.push_back(token);
+    field_has_value = true;
+  }
+  if (comma && !field_has_value) throw empty_field();
   for (size_t i = 0; i < tokens.size(); ++i) {
     const std::string& t = tokens[i];
     char* end = nullptr;

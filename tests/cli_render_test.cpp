@@ -143,7 +143,7 @@ TEST_F(CliRenderTest, BadInputExitsTwoAndWritesNothing) {
       {cell + " --out /nonexistent-folder/x.png", "cannot write there"},
       {cell + " --out " + path("x.jpg"), "must end in .png"},
       {cell + " --out " + out + " --waypoint 7", "--waypoint 7: " + b + " has 2 waypoints (0 .. 1)"},
-      {cell + " --out " + out + " --waypoint -2", "--waypoint -2"},
+      {cell + " --out " + out + " --waypoint -2", "--waypoint: '-2' must be a waypoint index, 0 or more"},
       {workcell("baltico") + " --bounds " + b + " --out " + out, "computed for another cell"},
       {cell + " --out " + out + " --size 12x", "--size '12x' must be WIDTHxHEIGHT"},
       {cell + " --out " + out + " --size 8x8", "from 16 to 8192"},

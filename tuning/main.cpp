@@ -75,16 +75,20 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--population", o.population,
                  "Population of isres, crs2, esch (0: 2 x (free variables + 1))")
+      ->check(CLI::Range(0, 10000))
       ->capture_default_str();
   app.add_option("--aggregate", o.aggregate, "Aggregate the cases' scores by their mean or the worst")
       ->check(CLI::IsMember({"mean", "worst"}))
       ->capture_default_str();
   app.add_option("--lambda", o.objective.lambda, "Objective: CF percentage points per second of time")
+      ->check(leeway::cli::finite_check())
       ->capture_default_str();
   app.add_option("--mu", o.objective.mu, "Objective: CF percentage points for a path of narrow intervals")
+      ->check(leeway::cli::finite_check())
       ->capture_default_str();
   app.add_option("--min-width", o.objective.min_width,
                  "Objective: bisected intervals narrower [rad] fall short")
+      ->check(leeway::cli::finite_check())
       ->capture_default_str();
   app.add_option("--time", o.time, "Time in the objective: calibrated proxy, or measured wall or CPU time")
       ->check(CLI::IsMember({"proxy", "wall", "cpu"}))
@@ -93,7 +97,8 @@ int main(int argc, char** argv) {
                  "The proxy's coefficients A,B,C,D [ms] (fixed, per check, per check and box, per check and "
                  "near pair) instead of calibrating them: reproducible objectives across machines");
   app.add_option("--repeats", o.repeats,
-                 "Runs per evaluation whose median is the time (default: 1 proxy, 3 else)");
+                 "Runs per evaluation whose median is the time (default: 1 proxy, 3 else)")
+      ->check(CLI::Range(1, 1000));
   app.add_option("--cf-windows", o.cf.windows, "CF windows")->capture_default_str();
   app.add_option("--cf-samples", o.cf.samples, "CF samples per window during the search")
       ->capture_default_str();
@@ -118,7 +123,8 @@ int main(int argc, char** argv) {
   app.add_option("--range", o.ranges, "Change a variable's bounds: NAME=LO:HI (max_cells in cells)");
   app.add_flag("--no-summary", o.no_summary, "Skip the before/after summary");
   app.add_option("--noise-study", o.noise_study,
-                 "Instead of tuning: evaluate the start and K-1 random points repeatedly into --log");
+                 "Instead of tuning: evaluate the start and K-1 random points repeatedly into --log")
+      ->check(CLI::Range(1, 100000));
   app.add_option("--noise-center", o.noise_center,
                  "--noise-study around this parameter file's point instead of over the whole box")
       ->check(leeway::cli::file_name_check());

@@ -64,7 +64,8 @@ CLI::App* add_batch(CLI::App& app, BatchArgs& args) {
   sub->add_option("--junit", args.junit, "Write a JUnit XML report here");
   sub->add_option("--out", args.out, "Write every result here (JSON)");
   sub->add_option("--threads", args.threads,
-                  "Worker threads per scenario (default: the cores divided among this machine's ranks)");
+                  "Worker threads per scenario (default: the cores divided among this machine's ranks)")
+      ->check(CLI::Range(1, kMaxThreads));
   return sub;
 }
 

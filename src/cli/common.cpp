@@ -50,7 +50,8 @@ void add_preset_options(CLI::App* sub, std::string& preset, std::string& safety)
       ->capture_default_str();
   sub->add_option("--safety", safety,
                   "certified (every interval proven free of the obstacles), sampled (an epsilon-delta\n"
-                  "sampling test) or none (the thesis's bounds as they are); default: the preset's");
+                  "sampling test) or none (the thesis's bounds as they are); default: the preset's")
+      ->check(non_empty_check("certified, sampled or none"));
 }
 
 Eigen::VectorXd configuration(const Scene& scene, const std::string& q, const std::string& key,

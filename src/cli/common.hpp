@@ -157,6 +157,15 @@ inline CLI::Validator file_name_check() {
       [](std::string& text) -> std::string { return text.empty() ? "the file name is empty" : ""; }, "");
 }
 
+//! A CLI11 check that an option given is not empty ("--safety ''"): `expected` says what to give.
+inline CLI::Validator non_empty_check(const std::string& expected) {
+  return CLI::Validator(
+      [expected](std::string& text) -> std::string {
+        return text.empty() ? "is empty; give " + expected : "";
+      },
+      "");
+}
+
 //! A CLI11 check for a number: finite (CLI11 accepts "nan" and "inf" for a double).
 inline CLI::Validator finite_check() {
   return CLI::Validator(

@@ -44,12 +44,19 @@ CLI::App* add_render(CLI::App& app, RenderArgs& args) {
   sub->add_option("--key", args.key, "Keyframe to show without bounds (default: the cell's first)")
       ->excludes(bounds);
   sub->add_option("--out", args.out, "PNG file to write")->check(file_name_check())->required();
-  sub->add_option("--waypoint", args.waypoint, "Waypoint shown, from 0 (default: the last)");
+  sub->add_option("--waypoint", args.waypoint, "Waypoint shown, from 0 (default: the last)")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            return text.find('-') == 0 ? "'" + text + "' must be a waypoint index, 0 or more" : "";
+          },
+          ""));
   sub->add_option("--camera", args.camera,
                   "Camera \"az,el,dist\": azimuth and elevation [rad] (elevation < 0 looks down), distance\n"
-                  "[m] (default: -2.4,-0.9 and a distance that frames the reach circle)");
+                  "[m] (default: -2.4,-0.9 and a distance that frames the reach circle)")
+      ->check(non_empty_check("three numbers az,el,dist"));
   sub->add_option("--lookat", args.lookat,
-                  "Point the camera looks at, \"x,y,z\" [m] (default: the reach circle's centre)");
+                  "Point the camera looks at, \"x,y,z\" [m] (default: the reach circle's centre)")
+      ->check(non_empty_check("three numbers x,y,z"));
   sub->add_option("--size", args.size, "Image size WIDTHxHEIGHT [pixels]")->capture_default_str();
   sub->add_option("--volume", args.volume, "Draw the volume: on or off (the thesis's fig. 3.4 after/before)")
       ->capture_default_str();

@@ -11,8 +11,10 @@ void apply_cell_defaults(const Scene& scene, Params& params) {
   auto numeric = [&](const char* name, double& out) {
     const int id = mj_name2id(&m, mjOBJ_NUMERIC, name);
     if (id < 0) return false;
-    if (m.numeric_size[id] < 1 || !std::isfinite(m.numeric_data[m.numeric_adr[id]]))
-      throw InputError(scene.source() + ": custom numeric '" + name + "' must hold one finite number");
+    // Exactly one value: a second ("2 500") is a typo or a misunderstanding, not something to ignore.
+    if (m.numeric_size[id] != 1 || !std::isfinite(m.numeric_data[m.numeric_adr[id]]))
+      throw InputError(scene.source() + ": custom numeric '" + name +
+                       "' must hold one finite number (it holds " + std::to_string(m.numeric_size[id]) + ")");
     out = m.numeric_data[m.numeric_adr[id]];
     return true;
   };

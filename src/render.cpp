@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <stdexcept>
 
 #include "json_io.hpp"
@@ -337,7 +338,12 @@ BoundsFileVolume read_bounds_volume(const std::string& path, const Scene& scene,
   if (!j.contains("params"))
     throw InputError(path + ": has no 'params': its volume cannot be regenerated (an older bounds file)");
   out.params = params_from_json(j.at("params"), path + " 'params'");
-  if (j.contains("boxes") && j.at("boxes").is_number_integer()) out.recorded_boxes = j.at("boxes").get<int>();
+  if (j.contains("boxes")) {
+    if (!j.at("boxes").is_number_integer() || j.at("boxes").get<long long>() < 0 ||
+        j.at("boxes").get<long long>() > std::numeric_limits<int>::max())
+      throw InputError(path + ": 'boxes' " + j.at("boxes").dump() + " must be a count of boxes, 0 or more");
+    out.recorded_boxes = j.at("boxes").get<int>();
+  }
   std::vector<Eigen::VectorXd> nominal;
   for (const auto& w : out.bounds) nominal.push_back(w.q);
   const Categories categories = categorize(scene, nominal, out.params.categorize);

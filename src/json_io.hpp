@@ -29,30 +29,75 @@ inline nlohmann::json to_json_array(const Eigen::VectorXd& v) {
 //! kMaxJsonDepth and a key given twice in one object are refused, as is a number outside the double
 //! range (nlohmann's "number overflow parsing '1e400'").
 //! @throws InputError "SOURCE: malformed JSON: ..." or "SOURCE: ..." naming the key (one line).
-inline nlohmann::json parse_json_text(const std::string& text, const std::string& source) {
-  // The parser is iterative; the callback sees every event with its depth before any recursion.
-  std::vector<std::set<std::string>> keys;  // the keys seen in each open object
-  auto callback = [&](int depth, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
-    using E = nlohmann::json::parse_event_t;
-    if (depth > kMaxJsonDepth)
-      throw InputError(source + ": JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
-    if (event == E::object_start) keys.emplace_back();
-    if (event == E::object_end && !keys.empty()) keys.pop_back();
-    if (event == E::key && !keys.empty()) {
-      const std::string key = parsed.get<std::string>();
-      if (!keys.back().insert(key).second)
-        throw InputError(source + ": JSON key '" + key + "' appears twice in one object");
-    }
-    return true;
-  };
-  try {
-    return nlohmann::json::parse(text, callback);
-  } catch (const nlohmann::json::exception& e) {
+// A SAX handler that builds the document as nlohmann's own DOM parser does (linear time; its
+// callback parser scans the parent array at every object's end, quadratic for a long list of
+// waypoints) while refusing nesting deeper than kMaxJsonDepth and a key given twice in one object.
+// The parser is iterative, so deep input is refused before anything recurses into it.
+class CheckedJsonSax {
+ public:
+  using json = nlohmann::json;
+  CheckedJsonSax(json& result, const std::string& source) : dom_(result, true), source_(source) {}
+
+  bool null() { return value() && dom_.null(); }
+  bool boolean(bool v) { return value() && dom_.boolean(v); }
+  bool number_integer(json::number_integer_t v) { return value() && dom_.number_integer(v); }
+  bool number_unsigned(json::number_unsigned_t v) { return value() && dom_.number_unsigned(v); }
+  bool number_float(json::number_float_t v, const json::string_t& s) {
+    return value() && dom_.number_float(v, s);
+  }
+  bool string(json::string_t& v) { return value() && dom_.string(v); }
+  bool binary(json::binary_t& v) { return value() && dom_.binary(v); }
+  bool start_object(std::size_t n) {
+    value();
+    ++depth_;
+    keys_.emplace_back();
+    return dom_.start_object(n);
+  }
+  bool key(json::string_t& k) {
+    if (!keys_.back().insert(k).second)
+      throw InputError(source_ + ": JSON key '" + k + "' appears twice in one object");
+    return dom_.key(k);
+  }
+  bool end_object() {
+    --depth_;
+    keys_.pop_back();
+    return dom_.end_object();
+  }
+  bool start_array(std::size_t n) {
+    value();
+    ++depth_;
+    return dom_.start_array(n);
+  }
+  bool end_array() {
+    --depth_;
+    return dom_.end_array();
+  }
+  template <class Exception>
+  bool parse_error(std::size_t, const std::string&, const Exception& e) {
     std::string message = e.what();
     for (char& ch : message)
       if (ch == '\n' || ch == '\r') ch = ' ';
-    throw InputError(source + ": malformed JSON: " + message);
+    throw InputError(source_ + ": malformed JSON: " + message);
   }
+
+ private:
+  // Every value, containers included, sits at the depth of the containers open around it.
+  bool value() const {
+    if (depth_ > kMaxJsonDepth)
+      throw InputError(source_ + ": JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+    return true;
+  }
+  nlohmann::detail::json_sax_dom_parser<json> dom_;
+  const std::string& source_;
+  int depth_ = 0;
+  std::vector<std::set<std::string>> keys_;  // the keys seen in each open object
+};
+
+inline nlohmann::json parse_json_text(const std::string& text, const std::string& source) {
+  nlohmann::json result;
+  CheckedJsonSax sax(result, source);
+  nlohmann::json::sax_parse(text, &sax);
+  return result;
 }
 
 //! Parses the JSON file at `path`; `what` names the kind of file in the error ("bounds file").

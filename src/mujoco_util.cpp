@@ -1,6 +1,7 @@
 #include "leeway/mujoco_util.hpp"
 
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <mutex>
@@ -82,7 +83,17 @@ ModelPtr load_model_file(const std::string& path) {
     // Every numeric attribute is checked before MuJoCo sees it: MuJoCo 2.2.2 reads "nan" as 0
     // (a body, a geom's orientation) with only a warning, and "inf" as it is.
     try {
-      read_mjcf_source(path);
+      // A FIFO, folder or device named as a mesh, texture or height field would block or fail in
+      // MuJoCo's reader; a missing one MuJoCo names itself.
+      for (const std::string& file : read_mjcf_source(path).files) {
+        std::error_code ec;
+        if (file == path || !std::filesystem::exists(file, ec)) continue;
+        try {
+          require_regular_input(file, "file it reads");
+        } catch (const InputError& e) {
+          throw InputError(path + ": " + e.what());
+        }
+      }
     } catch (const MjcfSyntaxError&) {
       // MuJoCo's message for a file that is not well-formed XML names the line and element.
       m = mj_loadXML(path.c_str(), nullptr, error, sizeof(error));

@@ -7,6 +7,7 @@
 #include "leeway/file_io.hpp"
 #include "leeway/mjcf_source.hpp"
 #include "leeway/nominal_path.hpp"
+#include "leeway/path_check.hpp"
 #include "leeway/planner.hpp"
 
 namespace leeway::cli {
@@ -60,6 +61,18 @@ int run_plan(const PlanArgs& args) {
   PlanResult result;
   Endpoint a, b;
   if (!plan_between(scene, args.from, args.to, args.ik_seed, options, result, a, b)) return kExitFindings;
+  // The planner checks its edges at --resolution; a path is written only when it also passes the
+  // fine edge check `leeway bounds --path` applies, so that what plan writes bounds reads.
+  const PathCheckOptions fine;
+  const PathCheckResult checked = check_path(scene, result.waypoints, fine);
+  if (!checked.free()) {
+    std::cerr << "leeway: collision: " << scene.source() << ": the path planned from " << args.from << " to "
+              << args.to << " " << describe_collision(scene, *checked.collision) << " when checked at "
+              << format_number(fine.resolution) << " rad (the planner checks at "
+              << format_number(options.resolution) << " rad: use a finer --resolution or another --seed)"
+              << "; nothing written\n";
+    return kExitFindings;
+  }
   const nlohmann::json out = path_json(scene, result, options, a, b);
   if (!args.out.empty()) write_file_atomic(args.out, out.dump(2) + "\n");
   if (args.json) {

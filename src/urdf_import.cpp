@@ -159,15 +159,26 @@ std::optional<std::string> package_xml_name(const fs::path& dir) {
   return first == std::string::npos ? std::string() : name.substr(first, last - first + 1);
 }
 
+// Most folders one package search looks into: a package path as wide as "/" would otherwise walk
+// the whole disk (for every mesh).
+constexpr int kMaxPackageSearchFolders = 20000;
+
 // A package below `root`: root/NAME, or a folder holding package.xml with <name>NAME</name>
-// (searched breadth-first in name order, not below other packages or hidden folders, 8 levels).
+// (searched breadth-first in name order, not below other packages or hidden folders, 8 levels,
+// at most kMaxPackageSearchFolders folders).
+// @throws InputError when the search stops at that limit without finding the package.
 std::optional<fs::path> find_package_in(const fs::path& root, const std::string& name) {
   std::error_code ec;
   if (fs::is_directory(root / name, ec)) return root / name;
   std::deque<std::pair<fs::path, int>> queue = {{root, 0}};
+  int visited = 0;
   while (!queue.empty()) {
     const auto [dir, depth] = queue.front();
     queue.pop_front();
+    if (++visited > kMaxPackageSearchFolders)
+      throw InputError("looking for ROS package '" + name + "' under '" + root.string() + "' stopped after " +
+                       std::to_string(kMaxPackageSearchFolders) +
+                       " folders; give the package's folder, or the folder holding it, with --package-path");
     if (const auto n = package_xml_name(dir)) {
       if (*n == name) return dir;
       if (depth > 0) continue;  // packages do not nest
@@ -751,10 +762,19 @@ std::string resolve_urdf_resource(const std::string& uri, const std::string& urd
     const std::string name = rest.substr(0, slash);
     if (name.empty() || slash == std::string::npos)
       throw InputError(what + ": '" + uri + "' is not package://NAME/PATH");
+    // The file must stay inside its package: no "..", as a name or climbing above the package.
+    const fs::path inside = fs::path(rest.substr(slash + 1)).lexically_normal();
+    if (name == "." || name == ".." || inside.empty() || inside.is_absolute() || *inside.begin() == "..")
+      throw InputError(what + ": '" + uri +
+                       "' leaves its package; package://NAME/PATH names a file inside it");
     std::vector<std::string> roots = options.package_paths;
     for (const auto& p : split_paths(options.ros_package_path)) roots.push_back(p);
-    for (const auto& root : roots)
-      if (const auto dir = find_package_in(root, name)) return (*dir / rest.substr(slash + 1)).string();
+    try {
+      for (const auto& root : roots)
+        if (const auto dir = find_package_in(root, name)) return (*dir / inside).string();
+    } catch (const InputError& e) {
+      throw InputError(what + ": " + e.what());
+    }
     throw InputError(what + ": no ROS package '" + name + "' under the package paths " +
                      join_names(options.package_paths) + " or ROS_PACKAGE_PATH '" + options.ros_package_path +
                      "' (a package is a folder of that name, or one holding a package.xml naming it)");

@@ -399,9 +399,15 @@ TEST_F(CliPathCheckTest, APlannedPathIsReCheckedFiner) {
 </mujoco>
 )";
   const std::string cell = dir_.write("pin.xml", xml.str()), out = file("b.json");
-  const auto plan = run_cli("plan " + cell + " --from home --to site:goal");
-  ASSERT_EQ(plan.exit_code, 0) << plan.out;
-  ASSERT_THAT(plan.out, HasSubstr("direct"));
+  // `plan` checks the path it found at 2 mrad before writing it, as `bounds` does.
+  const std::string path_file = file("p.json");
+  const auto plan = run_cli("plan " + cell + " --from home --to site:goal --out " + path_file);
+  EXPECT_EQ(plan.exit_code, 1) << plan.out;
+  EXPECT_THAT(plan.out,
+              HasSubstr(": the path planned from home to site:goal hits 'pin' on edge 0 -> 1 at s = "));
+  EXPECT_THAT(plan.out, HasSubstr("when checked at 0.002 rad (the planner checks at 0.01 rad: use a finer "
+                                  "--resolution or another --seed); nothing written"));
+  EXPECT_FALSE(std::filesystem::exists(path_file));
   const auto r = run_cli("bounds " + cell + " --from home --to site:goal --out " + out);
   EXPECT_EQ(r.exit_code, 1) << r.out;
   EXPECT_THAT(r.out,

@@ -86,13 +86,36 @@ inline int finish_stdout(const char* program, int code) {
 //! failure "PROGRAM: error: out of memory ..." and kExitBadInput, anything else
 //! "PROGRAM: internal error (please report): ..." and kExitInternal. Standard output is flushed and
 //! checked before an exit code is returned (finish_stdout).
+//! `message` on one line: a line break or other control character (a name in the input holding
+//! "&#10;" reaches the message as it is) is written as \n, \r or \xHH, so that no input can add a
+//! line of its own to the error.
+inline std::string one_line_message(const std::string& message) {
+  std::string out;
+  out.reserve(message.size());
+  for (const char c : message) {
+    const auto u = static_cast<unsigned char>(c);
+    if (c == '\n') {
+      out += "\\n";
+    } else if (c == '\r') {
+      out += "\\r";
+    } else if (u < 0x20 || u == 0x7f) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02x", u);
+      out += hex;
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
 template <class Body>
 int run_reporting_errors(const char* program, Body&& body) {
   int code = kExitInternal;
   try {
     code = body();
   } catch (const InputError& e) {
-    std::cerr << program << ": error: " << e.what() << "\n";
+    std::cerr << program << ": error: " << one_line_message(e.what()) << "\n";
     code = kExitBadInput;
   } catch (const std::bad_alloc&) {
     std::cerr << program
@@ -100,7 +123,7 @@ int run_reporting_errors(const char* program, Body&& body) {
                  " (fewer waypoints, windows, samples or MAX_cells need less); nothing written\n";
     code = kExitBadInput;
   } catch (const std::exception& e) {
-    std::cerr << program << ": internal error (please report): " << e.what() << "\n";
+    std::cerr << program << ": internal error (please report): " << one_line_message(e.what()) << "\n";
     code = kExitInternal;
   }
   return finish_stdout(program, code);

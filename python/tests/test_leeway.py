@@ -348,3 +348,24 @@ def test_bounds_releases_the_gil(dallara):
     # would tick only at the switches before and after.
     assert elapsed > 0.05, "the call was too short to tell"
     assert during >= 10, f"the counter advanced {during} times in {elapsed:.3f} s"
+
+
+def test_two_threads_share_a_scene(tmp_path):
+    # Scene and Bounds are immutable: two Python threads computing on one Scene at once get what
+    # one thread gets alone.
+    scene = one_link_cell(tmp_path)
+    alone = leeway.bounds(scene, "a", "b", waypoints=4, threads=1, **{"height_map.max_cells": 100})
+    results = [None, None]
+
+    def run(k):
+        results[k] = leeway.bounds(scene, "a", "b", waypoints=4, threads=1,
+                                   **{"height_map.max_cells": 100})
+
+    workers = [threading.Thread(target=run, args=(k,)) for k in range(2)]
+    for w in workers:
+        w.start()
+    for w in workers:
+        w.join()
+    for r in results:
+        np.testing.assert_array_equal(r.lower, alone.lower)
+        np.testing.assert_array_equal(r.upper, alone.upper)

@@ -75,11 +75,14 @@ std::vector<std::string> joint_names(const Scene& scene) {
 // JSON to Python objects through the standard library's json module (dicts, lists, numbers).
 py::object to_python(const json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
 
-// A Python value of a keyword parameter as JSON (bool before int: True is an int in Python).
-json to_json_value(const std::string& name, const py::handle& v) {
-  if (py::isinstance<py::bool_>(v)) return v.cast<bool>();
-  if (py::isinstance<py::int_>(v)) return v.cast<long long>();
-  if (py::isinstance<py::float_>(v)) return v.cast<double>();
+// A Python value of a keyword parameter as JSON (bool before int: True is an int in Python). numpy's
+// scalars count as numbers too (np.int64 through __index__, np.float64 through __float__).
+json to_json_value(const std::string& name, const py::handle& h) {
+  const auto v = py::reinterpret_borrow<py::object>(h);
+  if (py::isinstance<py::bool_>(v) || py::isinstance(v, py::module_::import("numpy").attr("bool_")))
+    return py::bool_(v).cast<bool>();
+  if (py::isinstance<py::int_>(v) || py::hasattr(v, "__index__")) return py::int_(v).cast<long long>();
+  if (py::isinstance<py::float_>(v) || py::hasattr(v, "__float__")) return py::float_(v).cast<double>();
   if (py::isinstance<py::str>(v)) return v.cast<std::string>();
   throw InputError("parameter '" + name + "': " + std::string(py::str(py::type::of(v).attr("__name__"))) +
                    " is not a number, bool or string");

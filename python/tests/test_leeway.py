@@ -250,7 +250,8 @@ def test_a_colliding_straight_path_raises_collision_error(tmp_path):
 
 def test_one_link_bounds_contain_the_nominal(tmp_path):
     scene = one_link_cell(tmp_path)
-    b = leeway.bounds(scene, "a", "b", waypoints=3, threads=1, **{"height_map.max_cells": 100})
+    # A numpy integer is a number like any other.
+    b = leeway.bounds(scene, "a", "b", waypoints=3, threads=1, **{"height_map.max_cells": np.int64(100)})
     # The straight path 0 .. 0.5 rad in three waypoints; at 1.5 rad/s each half lasts 1/6 s.
     np.testing.assert_allclose(b.nominal[:, 0], [0, 0.25, 0.5])
     np.testing.assert_allclose(b.times, [0, 1 / 6, 1 / 3])
@@ -309,6 +310,8 @@ def test_unknown_parameter_is_named(dallara):
         leeway.bounds(dallara, "home", "patch", **{"height_map.max_cellz": 300})
     with pytest.raises(ValueError, match="nosuchsection"):
         leeway.bounds(dallara, "home", "patch", nosuchsection=1)
+    with pytest.raises(ValueError, match="height_map.max_cells"):
+        leeway.bounds(dallara, "home", "patch", **{"height_map.max_cells": [300]})
 
 
 def test_bad_arguments_are_value_errors(dallara):

@@ -2,6 +2,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -281,6 +282,34 @@ void check_numbers(const std::string& file, const std::vector<XmlElement>& eleme
   }
 }
 
+// Most memory one texture or height field may ask MuJoCo for: it allocates what the attributes say
+// before reading anything (a builtin texture of 40,000 x 40,000 pixels asks for 4.5 GiB).
+constexpr double kMaxAssetBytes = 512.0 * 1024 * 1024;
+
+// Refuses a texture (width x height RGB pixels, six faces for a cube or skybox) or a height field
+// (nrow x ncol floats) above kMaxAssetBytes, before MuJoCo allocates it.
+void check_allocation(const std::string& file, const std::vector<XmlElement>& elements, const XmlElement& e) {
+  auto number = [&](const char* key) {
+    const std::string* v = e.attribute(key);
+    if (!v) return 0.0;
+    char* end = nullptr;
+    const double x = std::strtod(v->c_str(), &end);
+    return end == v->c_str() || !std::isfinite(x) || x < 0 ? 0.0 : x;
+  };
+  const bool texture = e.tag == "texture";
+  const std::string* type = e.attribute("type");
+  const double faces = texture && type && (*type == "cube" || *type == "skybox") ? 6 : 1;
+  const double a = number(texture ? "width" : "nrow"), b = number(texture ? "height" : "ncol");
+  const double bytes = a * b * (texture ? 3 * faces : 4);
+  if (bytes <= kMaxAssetBytes) return;
+  char size[32];
+  std::snprintf(size, sizeof size, "%.1f GiB", bytes / (1024.0 * 1024 * 1024));
+  throw InputError(file + ": " + element_label(elements, e) + " " + (texture ? "width" : "nrow") + " " +
+                   shown(*e.attribute(texture ? "width" : "nrow")) + " x " + (texture ? "height" : "ncol") +
+                   " " + shown(*e.attribute(texture ? "height" : "ncol")) + " needs about " + size +
+                   " (line " + std::to_string(e.line) + "); leeway allows 512 MiB per " + e.tag);
+}
+
 std::string read_text(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::ostringstream s;
@@ -303,6 +332,7 @@ struct Reader {
     for (const XmlElement& e : elements) {
       for (const auto& [attr, value] : e.attributes)
         if (is_numeric(elements, e, attr)) check_numbers(file, elements, e, attr, value);
+      if (e.tag == "texture" || e.tag == "hfield") check_allocation(file, elements, e);
       if (e.tag == "compiler") {
         if (const auto* v = e.attribute("meshdir")) meshdir = *v;
         if (const auto* v = e.attribute("texturedir")) texturedir = *v;
@@ -360,6 +390,8 @@ MjcfSource read_mjcf_source(const std::string& path) {
   for (const auto& [file, texture] : r.assets) out.files.push_back(r.resolve(file, texture));
   return out;
 }
+
+void require_shallow_xml(const std::string& text, const std::string& file) { scan_elements(text, file); }
 
 std::vector<std::string> model_input_files(const std::string& path) {
   if (fs::path(path).extension() == ".mjb") return {path};

@@ -19,6 +19,7 @@
 
 #include "leeway/file_io.hpp"
 #include "leeway/kinematics.hpp"
+#include "leeway/mjcf_source.hpp"
 #include "leeway/mujoco_util.hpp"
 #include "leeway/scene.hpp"
 #include "leeway/stl.hpp"
@@ -66,6 +67,7 @@ std::string urdfdom_message(const std::vector<std::string>& messages) {
 }
 
 urdf::ModelInterfaceSharedPtr parse_urdf(const std::string& file, const std::string& text) {
+  require_shallow_xml(text, file);  // urdfdom's TinyXML recurses: 50,000 levels overflow the stack
   static std::mutex mutex;
   std::lock_guard<std::mutex> lock(mutex);
   ErrorCollector collector;
@@ -694,6 +696,21 @@ class Importer {
                             std::map<std::pair<int, int>, std::vector<std::string>>& why) {
     const std::string& srdf = options_.srdf;
     require_regular_input(srdf, "SRDF file");
+    {
+      std::ifstream in(srdf, std::ios::binary);
+      try {
+        require_shallow_xml(std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()),
+                            srdf);
+      } catch (const MjcfSyntaxError& e) {
+        // "SRDF: line N: reason" -> "SRDF: not a valid SRDF: reason (line N)", as TinyXML's are.
+        const std::string what = std::string(e.what()).substr(srdf.size() + 2);
+        const size_t colon = what.find(": ");
+        throw InputError(srdf + ": not a valid SRDF: " +
+                         (colon == std::string::npos
+                              ? what
+                              : what.substr(colon + 2) + " (" + what.substr(0, colon) + ")"));
+      }
+    }
     TiXmlDocument doc;
     if (!doc.LoadFile(srdf))
       throw InputError(srdf + ": not a valid SRDF: " + doc.ErrorDesc() + " (line " +

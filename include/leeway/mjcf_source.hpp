@@ -37,6 +37,12 @@ struct MjcfSource {
 //! An include that cannot be read is left for MuJoCo to report.
 MjcfSource read_mjcf_source(const std::string& path);
 
+//! Checks that the XML `text` (read from `file`) nests no deeper than 1,000 elements and has no
+//! unterminated markup, without recursing: a tree parser (urdfdom's TinyXML) would exhaust the stack
+//! on a deeply nested file before reporting anything.
+//! @throws MjcfSyntaxError naming the file and the line.
+void require_shallow_xml(const std::string& text, const std::string& file);
+
 //! Every file a model file makes leeway read: a compiled model (.mjb) is itself alone, an MJCF
 //! file is read_mjcf_source's list. For refusing an output that would overwrite one of them.
 //! @throws InputError as read_mjcf_source.

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -214,8 +215,11 @@ void load(Problem& pb) {
   // Cases: files, keyframes, limits and volume pools, all before the first evaluation.
   leeway::SceneOptions scene_opts;
   scene_opts.tool_site = o.tool;
+  std::set<std::string> seen_cases;
   for (const auto& text : o.cases) {
     const auto spec = leeway::parse_case(text);
+    // A case given twice would only weigh twice (and load its cell and volume pool twice).
+    require(seen_cases.insert(spec.label()).second, "--case '" + text + "' is given twice");
     pb.cases.push_back(
         std::make_unique<TuningCase>(spec, pb.base_json, o.waypoints, max_cells_hi, scene_opts));
     pb.labels.push_back(spec.label());

@@ -4,8 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -27,6 +29,15 @@
 #endif
 
 namespace leeway::test {
+
+//! `n` samples scaled by LEEWAY_TEST_SAMPLE_SHARE (a share in (0, 1], default 1; at least 1): the
+//! sanitizer builds run the long sampling tests on a share of their samples, every code path still
+//! run (scripts/sanitize.sh).
+inline int scaled_count(int n) {
+  const char* env = std::getenv("LEEWAY_TEST_SAMPLE_SHARE");
+  const double share = env ? std::atof(env) : 1.0;
+  return share > 0 && share < 1 ? std::max(1, static_cast<int>(n * share)) : n;
+}
 
 //! A temporary directory removed when the object dies.
 class TempDir {

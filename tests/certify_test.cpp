@@ -76,8 +76,8 @@ int property_count(int fallback) {
   return env ? std::stoi(env) : fallback;
 }
 // Whether a property test drew enough regions for its statements that it is not vacuous (so many
-// certified, so many near an obstacle) to be expected: the sanitizer builds draw a tenth of the
-// regions (LEEWAY_CERTIFY_COUNT=40, scripts/sanitize.sh) to run every code path, not to sample.
+// certified, so many near an obstacle) to be expected: the sanitizer builds draw a twentieth of
+// the regions (LEEWAY_CERTIFY_COUNT=20, scripts/sanitize.sh) to run every code path, not to sample.
 bool sampled_enough(int count) { return count >= 50; }
 
 // Random joint boxes of one cell: centres uniform within the limits, close to an obstacle (exact

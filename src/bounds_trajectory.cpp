@@ -105,7 +105,7 @@ double BoundsTrajectory::t_at_s(double s) const {
   const auto [seg, f] = locate_s(s);
   if (bounds_.size() == 1) return 0.0;
   const double a = times_[static_cast<size_t>(seg)], b = times_[static_cast<size_t>(seg) + 1];
-  return f == 1.0 ? b : a + f * (b - a);
+  return f == 1.0 ? b : std::min(b, a + f * (b - a));  // rounding never leaves the segment's times
 }
 
 void BoundsTrajectory::interpolate(int segment, double f, Eigen::Ref<Eigen::VectorXd> nominal,
@@ -130,6 +130,9 @@ void BoundsTrajectory::interpolate(int segment, double f, Eigen::Ref<Eigen::Vect
     nominal[j] = a.q[j] + f * (b.q[j] - a.q[j]);
     lower[j] = a.lower[j] + f * (b.lower[j] - a.lower[j]);
     upper[j] = a.upper[j] + f * (b.upper[j] - a.upper[j]);
+    // The three are interpolated apart, so rounding could put the nominal value an ulp outside its
+    // box; it is inside in exact arithmetic (lower <= q <= upper at both ends).
+    if (lower[j] <= upper[j]) nominal[j] = std::clamp(nominal[j], lower[j], upper[j]);
   }
 }
 

@@ -70,9 +70,10 @@ run_address() {
 
 # The tests TSan runs: those that run work on two or more threads on purpose (one, two and four
 # threads compared, concurrent planners, batches, the safety stage's phases on one and two threads,
-# the tuner's interrupt and determinism, sweeps, the CF's windows). The rest of the suite is
-# single-threaded in what it checks.
-tsan_tests='Thread|Concurrent|BatchTest|CliSafetyTest\.SameCertifiedBoundsForOneAndTwoThreads|OneLinkSafetyTest|MujocoWarnings|Sweep\.|TuningTest\.(SigintStopsTheSearch|EvaluationIsDeterministic)|ConfidenceTest|DallaraBoundsTest|CollisionTest\.Bounds'
+# the tuner's determinism, sweeps, the CF's windows). The rest of the suite is
+# single-threaded in what it checks. (The tuner's SIGINT test waits for rows within a time limit that
+# the TSan build at -O1 does not meet: it tests a signal, not threads.)
+tsan_tests='Thread|Concurrent|BatchTest|CliSafetyTest\.SameCertifiedBoundsForOneAndTwoThreads|OneLinkSafetyTest|MujocoWarnings|Sweep\.|TuningTest\.EvaluationIsDeterministic|ConfidenceTest|DallaraBoundsTest|CollisionTest\.Bounds'
 
 run_thread() {
   local dir="${1:-build-tsan}"

@@ -46,14 +46,7 @@ BoundsTrajectory four_waypoints() {
                           {0, 2, 2, 5}, true);
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no InputError)";
-}
+using test::error_of;
 
 TEST(BoundsTrajectory, AtWaypointsItIsTheWaypointValueForValue) {
   const BoundsTrajectory tr = four_waypoints();

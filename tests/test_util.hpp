@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -17,6 +18,7 @@
 
 #include <sys/wait.h>
 
+#include "leeway/error.hpp"
 #include "leeway/mujoco_util.hpp"
 
 // LEEWAY_TEST_ASAN: this build runs under AddressSanitizer (LEEWAY_SANITIZE=address, gcc or clang).
@@ -29,6 +31,16 @@
 #endif
 
 namespace leeway::test {
+
+//! The message of the InputError `f` throws, or "(no InputError)" when it throws none.
+inline std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no InputError)";
+}
 
 //! `n` samples scaled by LEEWAY_TEST_SAMPLE_SHARE (a share in (0, 1], default 1; at least 1): the
 //! sanitizer builds run the long sampling tests on a share of their samples, every code path still

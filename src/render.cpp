@@ -311,6 +311,10 @@ Image render_scene(const Scene& scene, const RenderRequest& request) {
     const auto c = height_colour(b.center.z() + b.half_size.z(), max_top);
     const float rgba[4] = {c[0], c[1], c[2], static_cast<float>(request.volume_alpha)};
     mjvGeom& geom = scn.geoms[scn.ngeom++];
+    // mjv_makeScene does not clear its geoms and mjv_initGeom leaves the sorter's fields
+    // (camdist, modelrbound, transparent) as they were: start from zeros so that the picture does
+    // not depend on what the heap held before (it did: --threads 1 and 2 gave other PNGs).
+    geom = mjvGeom{};
     mjv_initGeom(&geom, mjGEOM_BOX, size, pos, mat, rgba);
     geom.category = mjCAT_DECOR;
     if (request.volume_alpha < 1) mark_transparent(geom);

@@ -29,10 +29,7 @@ std::vector<json> corpus_cases() {
   return manifest.at("cases").get<std::vector<json>>();
 }
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
+using test::read_text;
 
 std::string expand(std::string text, const std::string& tmp) {
   for (const auto& [key, value] : {std::pair<std::string, std::string>{"{corpus}", kCorpus}, {"{tmp}", tmp}})

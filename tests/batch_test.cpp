@@ -138,12 +138,7 @@ class XmlReader {
   size_t i_ = 0;
 };
 
-std::string read_text(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
+using test::read_text;
 
 // Every "timing" object removed: what must be the same on any number of ranks.
 json without_timing(json j) {

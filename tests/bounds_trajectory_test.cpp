@@ -254,10 +254,7 @@ TEST_F(BoundsFormatTest, CfThroughTheFileIsTheCfOfTheBounds) {
 
 // --- Exports ---
 
-std::string read_all(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
+using test::read_text;
 
 std::vector<std::string> lines_of(const std::string& text) {
   std::vector<std::string> out;
@@ -270,7 +267,7 @@ TEST(StagesExport, CsvHasUnitsColumnsAndOneRowPerStage) {
   test::TempDir dir;
   const std::string out = (dir.path() / "s.csv").string();
   write_stages(four_waypoints(), {"a", "b"}, 2, StagesFormat::kCsv, out, "in.json");
-  const auto lines = lines_of(read_all(out));
+  const auto lines = lines_of(read_text(out));
   ASSERT_EQ(lines.size(), 2u + 4u);  // units, header, t = 0, 2, 4, 5
   EXPECT_THAT(lines[0], HasSubstr("# leeway sample of in.json: t [s]"));
   EXPECT_EQ(lines[1], "t,s,nominal_a,lower_a,upper_a,nominal_b,lower_b,upper_b");
@@ -284,7 +281,7 @@ TEST(StagesExport, JsonHasEveryStage) {
   test::TempDir dir;
   const std::string out = (dir.path() / "s.json").string();
   write_stages(four_waypoints(), {"a", "b"}, 2.5, StagesFormat::kJson, out, "in.json");
-  const auto j = nlohmann::json::parse(read_all(out));
+  const auto j = nlohmann::json::parse(read_text(out));
   EXPECT_EQ(j.at("format"), "leeway-stages-1");
   ASSERT_EQ(j.at("stages").size(), 3u);
   EXPECT_EQ(j["stages"][1]["t"], 2.5);
@@ -355,7 +352,7 @@ TEST(StagesExport, NpzIsAZipOfNpyArraysNumpyReads) {
   test::TempDir dir;
   const std::string out = (dir.path() / "s.npz").string();
   write_stages(four_waypoints(), {"a", "b"}, 2, StagesFormat::kNpz, out, "in.json");
-  const auto arrays = read_npz(read_all(out));
+  const auto arrays = read_npz(read_text(out));
   ASSERT_EQ(arrays.size(), 6u);
   EXPECT_EQ(arrays.at("t.npy").shape, "(4,)");
   EXPECT_EQ(arrays.at("lower.npy").shape, "(4, 2)");

@@ -25,12 +25,7 @@ std::vector<std::string> lines_of(const std::string& text) {
   return lines;
 }
 
-std::string read_text(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
+using test::read_text;
 
 class CliBoundsTest : public ::testing::Test {
  protected:

@@ -123,10 +123,7 @@ std::vector<GoldenCase> golden_cases() {
   return c;
 }
 
-std::string read_text(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using test::read_text;
 
 //! Runs the CLI as "leeway" (argv[0], which CLI11 prints in --help) from the project's root; returns
 //! "exit: N\n--- stdout\n...--- stderr\n..." with the strips applied.

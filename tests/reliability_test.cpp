@@ -35,10 +35,7 @@ namespace fs = std::filesystem;
 
 const std::string kCorpus = std::string(LEEWAY_TEST_DATA_DIR) + "/../bad_input";
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
+using test::read_text;
 
 using test::error_of;
 

@@ -32,6 +32,12 @@
 
 namespace leeway::test {
 
+//! The whole content of a file, byte for byte ("" when it cannot be read).
+inline std::string read_text(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
 //! The message of the InputError `f` throws, or "(no InputError)" when it throws none.
 inline std::string error_of(const std::function<void()>& f) {
   try {

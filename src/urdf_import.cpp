@@ -222,6 +222,9 @@ struct Body {
   std::optional<Isometry3d> tool;  // the tool0 site in this body's frame
 };
 
+constexpr size_t kMaxChainJoints = 256;  //!< moving joints from the base to the tool
+constexpr size_t kMaxTreeDepth = 1024;   //!< links from the base to the deepest leaf
+
 class Importer {
  public:
   Importer(std::string file, const UrdfImportOptions& options) : file_(std::move(file)), options_(options) {
@@ -250,12 +253,19 @@ class Importer {
     const urdf::LinkConstSharedPtr base = find_base();
     const urdf::LinkConstSharedPtr tool = find_tool(base);
     for (auto l = tool; l != base; l = l->getParent()) chain_.insert(l->parent_joint->name);
+    check_depth(base, tool);
 
     Body root;
     root.link = base->name;
     root.comment = "base link '" + base->name + "' (fixed: the robot base)";
     bodies_.push_back(root);
     visit(base, 0, Isometry3d::Identity(), "");
+    for (const Body& b : bodies_)
+      if (b.link == "world")
+        throw InputError(link_label(b.link) +
+                         (b.joint ? " (the child of joint '" + b.joint->name + "')" : "") +
+                         " would be a body named 'world', a name MJCF keeps for its world body; rename "
+                         "the link in the URDF");
     if (bodies_.size() < 2)
       throw InputError(file_ + ": no revolute, continuous or prismatic joint between the base link '" +
                        base->name + "' and the tool link '" + tool->name +
@@ -282,6 +292,29 @@ class Importer {
       if (joints.size() > 1)
         throw InputError(file_ + ": link '" + link + "' is the child of joints " + join_names(joints) +
                          ": a joint loop (a URDF must be a tree, each link with one parent joint)");
+  }
+
+  // Each moving joint on the chain nests one <body> in the next, and MuJoCo's XML reader stops at
+  // 500 levels; visit() recurses once per link. Both are refused here, before any work, by count.
+  void check_depth(const urdf::LinkConstSharedPtr& base, const urdf::LinkConstSharedPtr& tool) const {
+    size_t moving = 0;
+    for (const auto& name : chain_)
+      if (model_->getJoint(name)->type != urdf::Joint::FIXED) ++moving;
+    if (moving > kMaxChainJoints)
+      throw InputError(file_ + ": the chain from the base link '" + base->name + "' to the tool link '" +
+                       tool->name + "' has " + std::to_string(moving) +
+                       " moving joints; leeway imports at most " + std::to_string(kMaxChainJoints) +
+                       " (each nests a body in the MJCF, which MuJoCo reads to 500 levels)");
+    std::vector<std::pair<urdf::LinkConstSharedPtr, size_t>> open{{base, 0}};
+    while (!open.empty()) {
+      const auto [link, depth] = open.back();
+      open.pop_back();
+      if (depth > kMaxTreeDepth)
+        throw InputError(link_label(link->name) + " is more than " + std::to_string(kMaxTreeDepth) +
+                         " links below the base link '" + base->name +
+                         "'; leeway imports trees up to that depth");
+      for (const auto& child : link->child_links) open.emplace_back(child, depth + 1);
+    }
   }
 
   urdf::LinkConstSharedPtr find_base() {

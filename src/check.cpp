@@ -89,6 +89,8 @@ CheckReport check_scene(const Scene& scene, const CheckOptions& options) {
   auto add_overlap = [&](int a, int b, const char* what) {
     const double depth = penetration(m, *rest, a, b);
     if (depth > options.overlap_tolerance) {
+      // Counted all, listed up to a limit: n coincident obstacles overlap in n (n - 1) / 2 pairs.
+      if (++report.overlap_count > kMaxListedOverlaps) return;
       report.overlaps.push_back({a, b, depth});
       report.problems.push_back(std::string(what) + " '" + scene.geom_label(a) + "' and '" +
                                 scene.geom_label(b) + "' overlap by " + format_number(depth) + " m");
@@ -113,6 +115,10 @@ CheckReport check_scene(const Scene& scene, const CheckOptions& options) {
   }
   for (int o : obstacles)
     for (int b : scene.base_geoms()) add_overlap(o, b, "obstacle and robot base");
+  if (report.overlap_count > kMaxListedOverlaps)
+    report.problems.push_back("... and " + std::to_string(report.overlap_count - kMaxListedOverlaps) +
+                              " more overlapping pairs (" + std::to_string(report.overlap_count) +
+                              " in all; the first " + std::to_string(kMaxListedOverlaps) + " are listed)");
 
   // Keyframes: collisions and joint limits.
   if (scene.keyframes().empty()) report.warnings.push_back("the cell has no keyframes");
@@ -291,6 +297,7 @@ nlohmann::json to_json(const Scene& scene, const CheckReport& report) {
     overlaps.push_back(
         {{"a", scene.geom_label(o.geom_a)}, {"b", scene.geom_label(o.geom_b)}, {"depth", o.depth}});
   out["overlaps"] = overlaps;
+  out["overlap_count"] = report.overlap_count;
   return out;
 }
 

@@ -203,11 +203,21 @@ TEST_F(CheckTest, ObstacleOverlapsAreEveryOverlappingPairInIndexOrder) {
       if (box_penetration(geom_box(m, *d, obstacles[i]), geom_box(m, *d, obstacles[j])) >
           CheckOptions{}.overlap_tolerance)
         expected.emplace_back(obstacles[i], obstacles[j]);
+  size_t with_base = 0;
+  for (int o : obstacles)
+    for (int b : scene_->base_geoms())
+      if (box_penetration(geom_box(m, *d, o), geom_box(m, *d, b)) > CheckOptions{}.overlap_tolerance)
+        ++with_base;
+  // Every pair counted; the first kMaxListedOverlaps listed (the obstacle pairs come first).
+  ASSERT_GT(expected.size(), kMaxListedOverlaps);  // not vacuous, and beyond the listed ones
+  EXPECT_EQ(r.overlap_count, expected.size() + with_base);
   std::vector<std::pair<int, int>> got;
   for (const Overlap& o : r.overlaps)
     if (scene_->role(o.geom_b) == GeomRole::kObstacle) got.emplace_back(o.geom_a, o.geom_b);
-  EXPECT_GT(expected.size(), 50u);  // not vacuous
-  EXPECT_EQ(got, expected);
+  const std::vector<std::pair<int, int>> listed(expected.begin(), expected.begin() + kMaxListedOverlaps);
+  EXPECT_EQ(got, listed);
+  EXPECT_THAT(r.problems.back(), HasSubstr("... and " + std::to_string(r.overlap_count - kMaxListedOverlaps) +
+                                           " more overlapping pairs"));
   // The text names the first 20 of the 400 and says how many it left out; the JSON has all.
   const std::string text = to_text(*scene_, r);
   EXPECT_THAT(text, HasSubstr("obstacles: 400 (o0, o1, "));

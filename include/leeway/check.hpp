@@ -44,6 +44,9 @@ struct GoalFindings {
   Eigen::VectorXd q_tool_down;       //!< that configuration (when reachable_tool_down)
 };
 
+//! Overlapping pairs listed in a report (and as problems); the rest are counted.
+inline constexpr size_t kMaxListedOverlaps = 100;
+
 //! Two collidable geoms (obstacle-obstacle or obstacle-robot base) that overlap.
 struct Overlap {
   int geom_a = -1;
@@ -57,7 +60,8 @@ struct CheckReport {
   std::vector<std::string> warnings;
   std::vector<KeyframeFindings> keyframes;
   std::vector<GoalFindings> goals;
-  std::vector<Overlap> overlaps;
+  std::vector<Overlap> overlaps;  //!< the first kMaxListedOverlaps overlapping pairs, in index order
+  size_t overlap_count = 0;       //!< every overlapping pair, listed or not
   bool ok() const { return problems.empty(); }
 };
 

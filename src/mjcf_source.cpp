@@ -282,6 +282,21 @@ void check_numbers(const std::string& file, const std::vector<XmlElement>& eleme
   }
 }
 
+// Refuses a name with a control character: names are printed in one-line messages, text reports
+// and CSV rows, and a newline written as &#10; would split a line so that a second could be forged.
+void check_name(const std::string& file, const XmlElement& e, const std::string& attr,
+                const std::string& value) {
+  for (size_t k = 0; k < value.size(); ++k) {
+    const auto c = static_cast<unsigned char>(value[k]);
+    if (c >= 0x20 && c != 0x7f) continue;
+    char code[8];
+    std::snprintf(code, sizeof code, "0x%02X", c);
+    throw InputError(file + ": " + e.tag + " " + attr + " (line " + std::to_string(e.line) +
+                     ") holds the control character " + code + " at character " + std::to_string(k + 1) +
+                     "; names must be printable");
+  }
+}
+
 // Most memory one texture or height field may ask MuJoCo for: it allocates what the attributes say
 // before reading anything (a builtin texture of 40,000 x 40,000 pixels asks for 4.5 GiB).
 constexpr double kMaxAssetBytes = 512.0 * 1024 * 1024;
@@ -330,6 +345,8 @@ struct Reader {
     includes.push_back(file);
     const std::vector<XmlElement> elements = scan_elements(read_text(file), file);
     for (const XmlElement& e : elements) {
+      for (const auto& [attr, value] : e.attributes)
+        if (attr == "name" || attr == "class" || attr == "childclass") check_name(file, e, attr, value);
       for (const auto& [attr, value] : e.attributes)
         if (is_numeric(elements, e, attr)) check_numbers(file, elements, e, attr, value);
       if (e.tag == "texture" || e.tag == "hfield") check_allocation(file, elements, e);
@@ -392,6 +409,18 @@ MjcfSource read_mjcf_source(const std::string& path) {
 }
 
 void require_shallow_xml(const std::string& text, const std::string& file) { scan_elements(text, file); }
+
+std::string first_model_section(const std::string& path) {
+  require_regular_input(path, "MJCF file");
+  static const std::set<std::string> sections = {
+      "compiler", "option",    "size",    "visual",   "statistic", "default",  "extension", "custom",
+      "asset",    "worldbody", "contact", "equality", "tendon",    "actuator", "sensor",    "keyframe"};
+  const std::vector<XmlElement> elements = scan_elements(read_text(path), path);
+  for (const XmlElement& e : elements)
+    if (e.parent == 0 && sections.count(e.tag))
+      return "<" + e.tag + "> (line " + std::to_string(e.line) + ")";
+  return "";
+}
 
 std::vector<std::string> model_input_files(const std::string& path) {
   if (fs::path(path).extension() == ".mjb") return {path};

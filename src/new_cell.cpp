@@ -143,6 +143,10 @@ NewCell write_new_cell(const std::string& robot_path, const std::string& cell_pa
   std::error_code ec;
   if (!fs::is_regular_file(robot_path, ec))
     throw InputError(robot_path + ": cannot open the robot file (missing or not a file)");
+  if (const std::string section = first_model_section(robot_path); !section.empty())
+    throw InputError(robot_path + ": has " + section +
+                     ": a whole MJCF model, not a robot fragment (the new cell includes the robot inside "
+                     "<worldbody>, so the file holds its bodies only, e.g. mjcf/robots/irb6700_body.xml)");
   if (!excludes_path.empty() && !fs::is_regular_file(excludes_path, ec))
     throw InputError(excludes_path + ": cannot open the excludes file (missing or not a file)");
   NewCell out;

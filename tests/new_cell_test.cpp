@@ -137,12 +137,14 @@ TEST(NewCellCliTest, BadRobotsExitTwoAndWriteNothing) {
                                      (dir.path() / "c1.xml").string());
   EXPECT_EQ(missing.exit_code, 2);
   EXPECT_THAT(missing.out, AllOf(HasSubstr("absent.xml"), HasSubstr("cannot open the robot file")));
-  // A whole model is no fragment: it does not compile inside <worldbody>; the message names the cell.
+  // A whole model is no fragment (it would not compile inside <worldbody>): the message names the
+  // robot file and its first model section, not the cell being written.
   const auto whole = test::run_cli("new-cell --robot " + std::string(LEEWAY_MJCF_DIR) +
                                    "/robots/irb6700.xml --out " + (dir.path() / "c2.xml").string());
   EXPECT_EQ(whole.exit_code, 2);
-  EXPECT_THAT(whole.out, AllOf(HasSubstr("leeway: error: " + (dir.path() / "c2.xml").string() +
-                                         ": MJCF does not compile")));
+  EXPECT_THAT(whole.out, HasSubstr("leeway: error: " + std::string(LEEWAY_MJCF_DIR) +
+                                   "/robots/irb6700.xml: has <compiler> (line 6): a whole MJCF model, "
+                                   "not a robot fragment"));
   EXPECT_EQ(std::count(whole.out.begin(), whole.out.end(), '\n'), 1) << whole.out;
   EXPECT_EQ(files_in(dir.path()), 0);
 }

@@ -48,4 +48,10 @@ void require_shallow_xml(const std::string& text, const std::string& file);
 //! @throws InputError as read_mjcf_source.
 std::vector<std::string> model_input_files(const std::string& path);
 
+//! The first child of the root element of the MJCF file at `path` that is a model section
+//! (compiler, option, asset, worldbody, keyframe, ...: what a fragment included inside <worldbody>
+//! cannot hold), as "<tag> (line N)"; empty when there is none.
+//! @throws InputError when the file cannot be read; MjcfSyntaxError as require_shallow_xml.
+std::string first_model_section(const std::string& path);
+
 }  // namespace leeway

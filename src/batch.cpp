@@ -15,6 +15,7 @@
 #include "leeway/confidence.hpp"
 #include "leeway/endpoints.hpp"
 #include "leeway/error.hpp"
+#include "leeway/file_io.hpp"
 #include "leeway/nominal_path.hpp"
 #include "leeway/params.hpp"
 #include "leeway/path_check.hpp"
@@ -262,9 +263,11 @@ Suite read_suite(const std::string& file) {
     run["cell"] = resolve(folder, s["cell"]);
     if (by_file) run["path"] = resolve(folder, s["path"]);
     if (s.contains("params") && s["params"].is_string()) run["params"] = resolve(folder, s["params"]);
-    if (!fs::is_regular_file(run["cell"].get<std::string>()))
-      f.fail("cell", "'" + s["cell"].get<std::string>() + "': no such file (looked for " +
-                         run["cell"].get<std::string>() + ")");
+    try {
+      require_regular_input(run["cell"].get<std::string>(), "cell file");
+    } catch (const InputError& e) {
+      f.wrap("cell", e);
+    }
     const std::string cell_file = run["cell"];
     auto& scene = scenes[{cell_file, s.value("checker", std::string("midphase"))}];
     try {

@@ -13,6 +13,21 @@ bool is_bounds_format(const nlohmann::json& format) {
   return format == nlohmann::json(kBoundsFormat) || format == nlohmann::json(kBoundsFormat1);
 }
 
+void require_bounds_shape(const nlohmann::json& j, const std::string& path) {
+  const std::string expected = std::string("'format' ") + kBoundsFormat + ", 'joints' and 'waypoints'";
+  if (!j.is_object())
+    throw InputError(path + ": not a leeway bounds file: a JSON " + std::string(j.type_name()) +
+                     ", not an object with " + expected);
+  if (j.contains("format") && !is_bounds_format(j.at("format")))
+    throw InputError(path + ": not a leeway bounds file: format " + j.at("format").dump() +
+                     " (leeway reads " + kBoundsFormat + " and " + kBoundsFormat1 + ")");
+  std::string missing;
+  for (const char* key : {"format", "joints", "waypoints"})
+    if (!j.contains(key)) missing += std::string(missing.empty() ? "no '" : ", no '") + key + "'";
+  if (j.contains("joints") && j.contains("waypoints")) return;  // older files have no 'format'
+  throw InputError(path + ": not a leeway bounds file: " + missing + " (a bounds file has " + expected + ")");
+}
+
 namespace {
 
 // What the bounds promise, as data: the region proven free (certified mode) or that nothing is
@@ -167,12 +182,7 @@ std::vector<WaypointBounds> bounds_from_json(const nlohmann::json& j, const std:
                                              const Scene* scene) {
   auto fail = [&](const std::string& what) { throw InputError(path + ": " + what); };
   try {
-    if (!j.is_object() || !j.contains("joints") || !j.contains("waypoints"))
-      fail("not a leeway bounds file (needs 'joints' and 'waypoints')");
-    // Older files have no 'format'; one that names another format is not ours to guess at.
-    if (j.contains("format") && !is_bounds_format(j.at("format")))
-      fail("format " + j.at("format").dump() + " is not a leeway bounds file (" + kBoundsFormat + " or " +
-           kBoundsFormat1 + ")");
+    require_bounds_shape(j, path);
     const auto names = j.at("joints").get<std::vector<std::string>>();
     if (names.empty()) fail("'joints' is empty");
     if (scene && names != scene->joint_names()) {

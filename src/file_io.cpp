@@ -1,6 +1,7 @@
 #include "leeway/file_io.hpp"
 
 #include <fcntl.h>
+#include <limits.h>
 #include <pthread.h>
 #include <signal.h>
 #include <sys/file.h>
@@ -177,6 +178,15 @@ void require_outputs(const std::vector<OutputFile>& outputs, const std::vector<s
     if (!fs::is_directory(folder, ec) || ::access(folder.c_str(), W_OK) != 0)
       throw InputError(named + ": cannot write there (folder '" + folder.string() +
                        "' missing or not writable)");
+    // A name the folder cannot hold would fail only when the finished file is moved into place.
+    const long name_max = ::pathconf(folder.c_str(), _PC_NAME_MAX);
+    const size_t name_bytes = fs::path(o.path).filename().string().size();
+    if (name_bytes > static_cast<size_t>(name_max > 0 ? name_max : 255))
+      throw InputError(named + ": the file name has " + std::to_string(name_bytes) + " bytes; folder '" +
+                       folder.string() + "' allows at most " + std::to_string(name_max > 0 ? name_max : 255));
+    if (fs::absolute(o.path, ec).string().size() >= PATH_MAX)
+      throw InputError(named + ": the path is longer than the system allows (" +
+                       std::to_string(PATH_MAX - 1) + " bytes)");
     struct stat st;
     if (!lstat_path(o.path, st)) continue;
     if (const std::string why = not_regular(st); !why.empty()) throw InputError(named + ": " + why);

@@ -30,6 +30,7 @@
 
 int main(int argc, char** argv) {
   using namespace leeway::cli;
+  ignore_sigpipe();                         // a closed standard output is exit 2, not SIGPIPE
   leeway::install_mujoco_error_handlers();  // MuJoCo errors become exceptions, not exit()
   leeway::install_temp_file_cleanup();      // no .NAME.tmpPID left behind by SIGTERM, SIGINT, SIGHUP
   CLI::App app{

@@ -223,11 +223,7 @@ BoundsSeries read_bounds_series(const std::string& path) {
   BoundsSeries out;
   out.source = path;
   try {
-    if (!j.is_object() || !j.contains("joints") || !j.contains("waypoints"))
-      fail("not a leeway bounds file (needs 'joints' and 'waypoints')");
-    if (j.contains("format") && !is_bounds_format(j.at("format")))
-      fail("format " + j.at("format").dump() + " is not a leeway bounds file (" + kBoundsFormat + " or " +
-           kBoundsFormat1 + ")");
+    require_bounds_shape(j, path);
     out.joints = j.at("joints").get<std::vector<std::string>>();
     const size_t dof = out.joints.size();
     if (dof == 0) fail("'joints' is empty");
@@ -428,18 +424,52 @@ Image bounds_image(const BoundsSeries& series, int width, int height) {
 // ---------------------------------------------------------------------------------------------
 // Sweep plots.
 
+namespace {
+
+// The fields of one CSV line as a spreadsheet writes them back: a field may be quoted ("a,b",
+// with "" for a quote inside), spaces around a field are dropped, a line may end in CR (CRLF).
+std::vector<std::string> csv_fields(std::string line, const std::string& where) {
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  std::vector<std::string> fields(1);
+  bool quoted = false, was_quoted = false;
+  for (size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c != '"') {
+        fields.back() += c;
+      } else if (i + 1 < line.size() && line[i + 1] == '"') {
+        fields.back() += '"';
+        ++i;
+      } else {
+        quoted = false;
+      }
+    } else if (c == '"' && !was_quoted && fields.back().find_first_not_of(" \t") == std::string::npos) {
+      fields.back().clear();
+      quoted = was_quoted = true;
+    } else if (c == ',') {
+      fields.emplace_back();
+      was_quoted = false;
+    } else if (!(was_quoted && (c == ' ' || c == '\t'))) {
+      fields.back() += c;
+    }
+  }
+  if (quoted) throw InputError(where + ": a quoted field is not closed");
+  for (auto& f : fields) {
+    const size_t b = f.find_first_not_of(" \t"), e = f.find_last_not_of(" \t");
+    f = b == std::string::npos ? std::string() : f.substr(b, e - b + 1);
+  }
+  return fields;
+}
+
+}  // namespace
+
 SweepSeries read_sweep_csv(const std::string& path) {
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open the sweep CSV file");
-  auto split = [](const std::string& line) {
-    std::vector<std::string> f;
-    std::stringstream fields(line);
-    for (std::string x; std::getline(fields, x, ',');) f.push_back(x);
-    return f;
-  };
   std::string line;
   if (!std::getline(in, line)) throw InputError(path + ": empty sweep CSV file");
-  const auto header = split(line);
+  if (line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // a UTF-8 byte order mark
+  const auto header = csv_fields(line, path + ": line 1");
   std::vector<size_t> col;
   for (const char* name : {"max_cells", "boxes", "time_ms", "cf"}) {
     const auto it = std::find(header.begin(), header.end(), name);
@@ -450,7 +480,8 @@ SweepSeries read_sweep_csv(const std::string& path) {
   SweepSeries out{std::filesystem::path(path).stem().string(), {}};
   for (int number = 2; std::getline(in, line); ++number) {
     if (line.empty()) continue;
-    const auto f = split(line);
+    if (line == "\r") continue;
+    const auto f = csv_fields(line, path + ": line " + std::to_string(number));
     double v[4] = {};
     for (size_t k = 0; k < 4; ++k) {
       const std::string where =

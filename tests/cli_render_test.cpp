@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "leeway/export_mjcf.hpp"
+#include "leeway/plot.hpp"
 #include "leeway/render.hpp"
 #include "leeway/scene.hpp"
 #include "png_util.hpp"
@@ -270,6 +271,30 @@ TEST_F(CliRenderTest, SweepPlotHasTheThesisSeriesForOneOfTheNineCases) {
               path("s.pdf"));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_THAT(r.out, HasSubstr("must end in .svg or .png"));
+}
+
+// A sweep CSV saved again by a spreadsheet: a byte order mark, quoted header fields and numbers,
+// spaces after the commas and CRLF line ends read as the file leeway wrote.
+TEST(SweepCsvTest, ReadsASpreadsheetsCsvWithBomQuotesAndCrlf) {
+  test::TempDir dir;
+  const std::string file =
+      dir.write("s.csv",
+                "\xEF\xBB\xBF\"max_cells\", \"boxes\",\"time_ms\" ,\"cf\",\"note, with comma\"\r\n"
+                "100,60,18.3,0.9,\"say \"\"hi\"\"\"\r\n"
+                "\"1000\", 600 ,80,\"0.99\",\r\n\r\n");
+  const SweepSeries s = read_sweep_csv(file);
+  ASSERT_EQ(s.points.size(), 2u);
+  EXPECT_EQ(s.points[0].max_cells, 100);
+  EXPECT_DOUBLE_EQ(s.points[0].boxes, 60);
+  EXPECT_DOUBLE_EQ(s.points[0].time_ms, 18.3);
+  EXPECT_DOUBLE_EQ(s.points[0].cf_percent, 90);
+  EXPECT_EQ(s.points[1].max_cells, 1000);
+  EXPECT_DOUBLE_EQ(s.points[1].boxes, 600);
+  EXPECT_DOUBLE_EQ(s.points[1].time_ms, 80);
+  EXPECT_DOUBLE_EQ(s.points[1].cf_percent, 99);
+  const std::string open_quote = dir.write("q.csv", "max_cells,boxes,time_ms,cf\n\"100,60,18.3,0.9\n");
+  EXPECT_EQ(test::error_of([&] { read_sweep_csv(open_quote); }),
+            open_quote + ": line 2: a quoted field is not closed");
 }
 
 TEST_F(CliRenderTest, PlotOfSweepCsvFilesBesideTheThesisTable) {

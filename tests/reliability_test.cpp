@@ -1,13 +1,16 @@
 // Issue 14's defects that the bad-input corpus (bad_input_test.cpp) cannot show from a command line:
 // the JSON reader's limits, output files and signals, thread creation failures, allocation
 // failures, MuJoCo warnings from worker threads, sweep rows and leeway-tune's log.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <spawn.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <filesystem>
 #include <fstream>
@@ -388,6 +391,58 @@ TEST(Tune, InterruptedCalibrationKeepsTheLog) {
   EXPECT_NE(r.out.find("exit=130"), std::string::npos) << r.out;
   EXPECT_EQ(read_text(log), "an earlier run's rows\n");
   EXPECT_FALSE(fs::exists(dir.path() / "tuned.json"));
+}
+
+// Runs `argv` with standard output a pipe whose reading end is closed before the program starts
+// (as `leeway check --json | head -c 1` once head has gone) and standard error into `err`; SIGPIPE
+// starts at its default action. Returns the wait status, -1 when the program could not be started.
+int run_into_closed_pipe(const std::vector<std::string>& argv, const std::string& err) {
+  int fds[2];
+  if (::pipe(fds) != 0) return -1;
+  ::close(fds[0]);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, fds[1], 1);
+  posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawnattr_t attr;
+  posix_spawnattr_init(&attr);
+  sigset_t defaults;
+  sigemptyset(&defaults);
+  sigaddset(&defaults, SIGPIPE);
+  posix_spawnattr_setsigdefault(&attr, &defaults);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGDEF);
+  std::vector<char*> args;
+  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  pid_t pid = 0;
+  const int rc = ::posix_spawn(&pid, args[0], &actions, &attr, args.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  posix_spawnattr_destroy(&attr);
+  ::close(fds[1]);
+  if (rc != 0) return -1;
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return status;
+}
+
+// A closed standard output is the documented exit 2 with one line on standard error, not death by
+// SIGPIPE (exit 141 in a shell), for leeway and leeway-tune.
+TEST(ClosedPipe, StandardOutputClosedIsExitTwo) {
+  test::TempDir dir;
+  const std::string err = (dir.path() / "err.txt").string();
+  const std::string tune = (fs::path(LEEWAY_CLI).parent_path() / "leeway-tune").string();
+  for (const auto& argv : std::vector<std::vector<std::string>>{
+           {LEEWAY_CLI, "check", kCorpus + "/cells/ok.xml", "--json"}, {tune, "--help"}}) {
+    const int status = run_into_closed_pipe(argv, err);
+    ASSERT_NE(status, -1) << argv[0];
+    EXPECT_FALSE(WIFSIGNALED(status)) << argv[0] << " died by signal " << WTERMSIG(status);
+    ASSERT_TRUE(WIFEXITED(status)) << argv[0];
+    EXPECT_EQ(WEXITSTATUS(status), 2) << argv[0];
+    const std::string text = read_text(err);
+    EXPECT_NE(text.find("error: standard output: writing failed (Broken pipe)"), std::string::npos)
+        << argv[0] << ": " << text;
+    EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << text;
+  }
 }
 
 }  // namespace

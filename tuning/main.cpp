@@ -39,6 +39,7 @@ int tune(Problem& pb, std::ostream* log) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  leeway::cli::ignore_sigpipe();  // a closed standard output is exit 2, not SIGPIPE
   CLI::App app{
       "leeway-tune: search the height-function parameters with NLopt to maximise CF per unit of time\n"
       "over (cell, path) cases; writes a parameter file for `leeway bounds --params` (docs/tuning.md).\n"

@@ -29,6 +29,11 @@ inline constexpr const char* kBoundsFormat1 = "leeway-bounds-1";
 //! True when `format` is a bounds file format leeway reads (kBoundsFormat or kBoundsFormat1).
 bool is_bounds_format(const nlohmann::json& format);
 
+//! Refuses JSON that is not a bounds file, naming what it lacks: an object with 'joints' and
+//! 'waypoints' and, when it has a 'format' (older files have none), one is_bounds_format accepts.
+//! @throws InputError "PATH: not a leeway bounds file: ...".
+void require_bounds_shape(const nlohmann::json& j, const std::string& path);
+
 //! The bounds file (docs/cli.md): joints, waypoints (q, lower, upper), boxes, max_cells, timing_ms...
 nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Params& params);
 

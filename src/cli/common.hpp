@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <cerrno>
 #include <cmath>
+#include <csignal>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -66,6 +67,11 @@ inline std::optional<int> parse_cli(CLI::App& app, int argc, char** argv, const 
   }
   return std::nullopt;
 }
+
+//! Lets a write to a closed pipe fail with EPIPE instead of killing the process with SIGPIPE
+//! (`leeway check --json | head -c 1` ended in 141): finish_stdout then reports the lost output as
+//! exit 2. Programs call it first in main().
+inline void ignore_sigpipe() { std::signal(SIGPIPE, SIG_IGN); }
 
 //! Flushes standard output and checks that everything written to it arrived: a full disk, a
 //! closed pipe or /dev/full must not end in exit 0. Returns `code`, or kExitBadInput after one line

@@ -59,6 +59,7 @@ asan_skip+='|CliPlanTest\.(BoundsAlongAPathFile|BoundsPlansFirstForASiteGoal)'
 asan_skip+='|CliSafetyTest\.(CertifiedBoundsScoreNoCollisionOnTheThreeCells|BalticoPatchMouldIsCertifiedFreeOfItself|PresetsRoundTripThroughParams|SameCertifiedBoundsForOneAndTwoThreads)'
 asan_skip+='|CliBoundsTest\.(CfBadInputsExitTwo|SweepPrintsTheTableAndWritesTheCsv|SweepTakesCfSettingsFromTheParameterFile|BoundsJsonOnStandardOutput)'
 asan_skip+='|BoundsFileTest\.(ReadChecksTheFormat|ReadKeepsTheCollapsedJoints|ReadRejectsFilesThatDoNotFit)'
+asan_skip+='|CliRenderTest\.SamePictureForOneAndTwoThreadsAndFromTheFile'
 
 run_address() {
   local dir="${1:-build-asan}"

@@ -1,4 +1,4 @@
-// The fast collision core against MuJoCo's full pass (issue 10), with Google Benchmark: one check
+// The fast collision core against MuJoCo's full pass, with Google Benchmark: one check
 // against volumes of growing size for both checkers, a whole bounds run against MAX_cells, and
 // `leeway cf`'s sampling. Dallara home-patch with the thesis's parameters (section 4.1).
 //

@@ -353,7 +353,7 @@ json run_scenario(const json& resolved, int threads) {
       timing["check_s"] = seconds_since(c0);
     }
     // The nominal path: from a file, planned between gripper goals, or joint-linear between two
-    // keyframes and planned around when it collides (as `leeway bounds`, issue #9).
+    // keyframes and planned around when it collides (as `leeway bounds`).
     PlanOptions plan;
     if (s.contains("plan")) {
       plan.seed = s["plan"].value("seed", plan.seed);

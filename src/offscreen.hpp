@@ -1,7 +1,7 @@
 #pragma once
 // Internal: an OSMesa OpenGL context made current on this thread, with a MuJoCo rendering context
 // whose offscreen buffer has the requested size (not public API). MuJoCo 2.2.2 links no GL and
-// finds the GL functions of whatever context is current (shared/notes/mujoco-2.2.2.md), so the
+// finds the GL functions of whatever context is current, so the
 // OSMesa context is made current before mjr_makeContext.
 
 #include <mujoco/mujoco.h>

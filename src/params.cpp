@@ -161,7 +161,7 @@ void Params::validate() const {
     }
   });
   // Physical bounds: a workcell is metres across; lengths beyond kMaxLength [m] or steps below the
-  // lower bounds would only produce unusable bounds or run for ever (issue 14).
+  // lower bounds would only produce unusable bounds or run for ever.
   const HeightMapParams& hm = height_map;
   require_between("height_map.max_cells", hm.max_cells, 1, kMaxCellsLimit);
   require_between("height_map.origin_x", hm.origin_x, -kMaxLength, kMaxLength);

@@ -145,7 +145,7 @@ void Scene::recognise(const SceneOptions& options) {
                        unit + " (after MuJoCo's unit conversion); no robot joint moves that far");
     // MuJoCo compiles a NaN or inf joint axis or anchor (it normalises the axis without checking):
     // the links' poses are then NaN at every value but the reference, and the midphase's cell
-    // index of a NaN coordinate is undefined behaviour (issue 14's fuzzing; fuzz/regressions/cell/).
+    // index of a NaN coordinate is undefined behaviour (found by fuzzing; fuzz/regressions/cell/).
     auto require_finite = [&](const char* what, const mjtNum* v) {
       if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
         throw InputError(file + ": joint " + label + " " + what + " '" + format_number(v[0]) + " " +
@@ -273,7 +273,7 @@ void Scene::recognise(const SceneOptions& options) {
     refuse("world position", d->geom_xpos + 3 * g, 3, kMaxLength, " m");
     refuse("world orientation", d->geom_xmat + 9 * g, 9, 2.0, "");
     // The contact margin and gap widen every collision query: a NaN made the midphase's cell index
-    // undefined behaviour, an inf one made every geom touch (issue 14's fuzzing; fuzz/regressions/cell/).
+    // undefined behaviour, an inf one made every geom touch (found by fuzzing; fuzz/regressions/cell/).
     refuse("margin", m.geom_margin + g, 1, kMaxLength, " m");
     refuse("gap", m.geom_gap + g, 1, kMaxLength, " m");
   }

@@ -237,7 +237,7 @@ void VolumeModel::grow(int capacity) {
       growth_ = Growth::kXml;  // another MuJoCo's binary layout
     }
   if (!grown) {
-    // Compile the pool from XML (quadratic in the pool size, shared/notes/mujoco-2.2.2.md, but it
+    // Compile the pool from XML (quadratic in the pool size, but it
     // does not depend on the binary layout).
     model_ = compile_xml(pool_xml(*scene_, capacity), scene_->source());
     pool_body_ = mj_name2id(model_.get(), mjOBJ_BODY, kVolumeBodyName);

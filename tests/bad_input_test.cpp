@@ -1,4 +1,4 @@
-// The bad-input corpus (issue 14): tests/bad_input/manifest.json lists command lines over the cells,
+// The bad-input corpus: tests/bad_input/manifest.json lists command lines over the cells,
 // parameter, bounds and path files of tests/bad_input/ with the exit code and a fragment of the
 // message each must give; every entry is one test, run in a fresh temporary folder.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// leeway batch (issue 15): suites with passing, failing and erroring scenarios, the JUnit report
+// leeway batch: suites with passing, failing and erroring scenarios, the JUnit report
 // parsed as a CI server would, bad suites refused before anything runs, and the same results over
 // MPI ranks (when mpirun was found at configure time).
 #include <gmock/gmock.h>

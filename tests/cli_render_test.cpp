@@ -1,4 +1,4 @@
-// The picture subcommands as a user runs them (issue 11): leeway render, leeway plot, sweep --plot
+// The picture subcommands as a user runs them: leeway render, leeway plot, sweep --plot
 // and bounds --export-mjcf/--export-mjb; their files, and their bad input (exit 2, nothing written).
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The fast collision core (issue 10): the midphase grid against brute force, and the midphase
+// The fast collision core: the midphase grid against brute force, and the midphase
 // checker against MuJoCo's full mj_collision pass on the three thesis cells.
 #include "leeway/collision.hpp"
 

@@ -1,4 +1,4 @@
-// The dense check of the nominal path (issue #9): the library against positions derived by hand
+// The dense check of the nominal path: the library against positions derived by hand
 // from the geometry, and `leeway bounds` / `leeway sweep` as a user runs them.
 #include "leeway/path_check.hpp"
 

@@ -1,4 +1,4 @@
-// Issue 14's defects that the bad-input corpus (bad_input_test.cpp) cannot show from a command line:
+// Defects that the bad-input corpus (bad_input_test.cpp) cannot show from a command line:
 // the JSON reader's limits, output files and signals, thread creation failures, allocation
 // failures, MuJoCo warnings from worker threads, sweep rows and leeway-tune's log.
 #include <fcntl.h>

@@ -1,4 +1,4 @@
-// The safety stage (issue 9): bounds shrunk until every segment is certified free of the real
+// The safety stage: bounds shrunk until every segment is certified free of the real
 // obstacles, the sampled mode, the presets, and the thesis's method left exactly as it was.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

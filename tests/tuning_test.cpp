@@ -1,4 +1,4 @@
-// Tuning (issue #5): the core in the library (cases, variables, time proxy, objective), the NLopt
+// Tuning: the core in the library (cases, variables, time proxy, objective), the NLopt
 // loop of tuning/ on synthetic objectives, and leeway-tune run as a user runs it on a tiny cell.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -110,8 +110,8 @@ TEST_F(UrdfImportTest, Irb6700MatchesTheHandWrittenModel) {
   EXPECT_EQ(imported.link_geoms().size(), hand.link_geoms().size());
   EXPECT_EQ(imported.base_geoms().size(), 1u);
 
-  // Hand-worked values (shared/notes/irb6700.md): home puts tool0 at (1.7025, 0, 2.26) m, tool z
-  // along +x; the thesis's Dallara patch pose puts it at (943, -1910, 800) mm.
+  // Hand-worked values (the chain's offsets in mjcf/robots/irb6700_body.xml): home puts tool0 at (1.7025,
+  // 0, 2.26) m, tool z along +x; the thesis's Dallara patch pose puts it at (943, -1910, 800) mm.
   RobotState a(imported), b(hand);
   const Pose home = a.fk(Eigen::VectorXd::Zero(6));
   EXPECT_NEAR((home.position - Eigen::Vector3d(1.7025, 0, 2.26)).norm(), 0, 1e-12);

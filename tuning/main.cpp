@@ -1,5 +1,5 @@
 // leeway-tune: searches the height-function parameters with NLopt to maximise the Confidence
-// Factor per unit of time on a set of (cell, path) cases (issue #5). docs/tuning.md describes the
+// Factor per unit of time on a set of (cell, path) cases. docs/tuning.md describes the
 // objective, the algorithm, the noise handling and a full run. Units SI; times in ms unless noted.
 // This file wires CLI11 and runs the stages in order; each stage is in its own file (stages.hpp).
 #include <CLI/CLI.hpp>

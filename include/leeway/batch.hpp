@@ -1,6 +1,6 @@
 #pragma once
 //! @file batch.hpp
-//! Scenario suites (issue 15): many (cell, path, parameters) runs of the method with expectations
+//! Scenario suites: many (cell, path, parameters) runs of the method with expectations
 //! on their outcome, their results as JSON and as a JUnit XML report. docs/batch.md gives the
 //! suite format; the `leeway batch` program runs a suite on one process or over MPI ranks.
 

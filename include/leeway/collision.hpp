@@ -1,6 +1,6 @@
 #pragma once
 //! @file collision.hpp
-//! Collision checks whose cost does not grow with the static geoms (issue #10): the robot's link
+//! Collision checks whose cost does not grow with the static geoms: the robot's link
 //! geoms against static geoms (the volume's pool, the real obstacles) through the midphase of
 //! midphase.hpp, then MuJoCo's own narrowphase (mjCOLLISIONFUNC) on the few pairs left, with
 //! mj_collision's filters, margins and bounding-sphere tests in its order. The answer "is there a

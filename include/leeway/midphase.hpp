@@ -1,6 +1,6 @@
 #pragma once
 //! @file midphase.hpp
-//! The midphase over static geoms (issue #10): their world axis-aligned boxes in a 2D grid over the
+//! The midphase over static geoms: their world axis-aligned boxes in a 2D grid over the
 //! floor plane with a max/min-height pyramid, so that a query visits only the cells under a link's
 //! footprint whose height range meets the link's, and skips every block of lower cells at once.
 //! The volume is a height map, so its boxes fill such a grid one per cell; the real obstacles use

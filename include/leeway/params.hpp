@@ -21,7 +21,7 @@ enum class DistanceMode {
 //! Params::validate, make_grid and the programs' options all check against this one value.
 constexpr int kMaxCellsLimit = 1000000;
 
-//! Physical bounds on the input (issue 14): a workcell is metres across, so lengths (parameters,
+//! Physical bounds on the input: a workcell is metres across, so lengths (parameters,
 //! joint ranges of slide joints [m], obstacle positions and sizes) and hinge ranges [rad] beyond
 //! this are refused as mistakes; they would only produce unusable bounds or overflow.
 constexpr double kMaxLength = 1e3;

@@ -1,6 +1,6 @@
 #pragma once
 //! @file path_check.hpp
-//! The dense check of a nominal path (issue #9, "the nominal path is checked first"): the thesis's
+//! The dense check of a nominal path ("the nominal path is checked first"): the thesis's
 //! method (chapter 3) bounds the joints around a nominal path that, in our reading, it assumes
 //! collision-free, so
 //! every configuration along the path, not only the waypoints, is checked against the real

@@ -1,6 +1,6 @@
 #pragma once
 //! @file planner.hpp
-//! The global planner (issue #4): the nominal path between two gripper positions, as in the thesis
+//! The global planner: the nominal path between two gripper positions, as in the thesis
 //! (chapter 3: "The development and testing of the algorithm were done using RRT-connect as a
 //! global planner"; section 4.1: the global planner takes "into input the starting and the goal
 //! position of the robot gripper"). OMPL's RRT-Connect plans in joint space over every robot joint

@@ -1,6 +1,6 @@
 #pragma once
 //! @file plot.hpp
-//! Plots (issue 11): each joint's bounds along the path (the thesis's figs. 4.4-4.16), and a
+//! Plots: each joint's bounds along the path (the thesis's figs. 4.4-4.16), and a
 //! sweep's boxes, time and CF against MAX_cells (tables 4.1-4.9) beside the thesis's published
 //! values. Written as SVG directly, or as PNG through MuJoCo's figure renderer (offscreen, OSMesa).
 

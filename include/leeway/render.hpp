@@ -1,6 +1,6 @@
 #pragma once
 //! @file render.hpp
-//! Pictures of a cell (issue 11): offscreen MuJoCo renders through OSMesa (no display needed) of the
+//! Pictures of a cell: offscreen MuJoCo renders through OSMesa (no display needed) of the
 //! robot at a configuration, the generated volume as semi-transparent boxes coloured by height, and
 //! ghosts of the robot at the extremes of its intervals; PNG encoding; the volume of a bounds file.
 

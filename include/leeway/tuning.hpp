@@ -1,6 +1,6 @@
 #pragma once
 //! @file tuning.hpp
-//! Automated tuning of the height-function parameters (issue #5; the thesis tuned them "through
+//! Automated tuning of the height-function parameters (the thesis tuned them "through
 //! trial and error", section 4.1): tuning cases, the tuned variables and their bounds, one
 //! evaluation of a parameter set on a case, the deterministic time proxy and the objective.
 //! The optimiser loop (NLopt) is in tuning/; docs/tuning.md describes every choice.

@@ -27,7 +27,7 @@ class VolumeModel {
   //! and sizes, on one free body: their poses are written per check) and a static body
   //! `leeway_volume` holding one template box geom, compiles it, then grows the pool to `capacity`
   //! geoms by rewriting the compiled model through MuJoCo's binary format (MuJoCo's compiler is
-  //! quadratic in the geom count: ~20 s for 100,000 geoms, shared/notes/mujoco-2.2.2.md; ~20 ms this
+  //! quadratic in the geom count: ~20 s for 100,000 geoms; ~20 ms this
   //! way). When the binary layout is not the one this code knows (another MuJoCo), the pool is
   //! compiled from XML instead.
   //! `growth` kXml forces the XML path (tests compare the two).

@@ -148,7 +148,7 @@ int run_bounds(const BoundsArgs& args) {
       return kExitFindings;
     path = planned.waypoints;
   }
-  // Issue #9: the nominal path is checked first, densely, whatever its source: the thesis's
+  // The nominal path is checked first, densely, whatever its source: the thesis's
   // method (chapter 3) assumes it collision-free (our reading).
   const PathCheckOptions check;
   PathCheckResult checked = check_path(scene, path, check);

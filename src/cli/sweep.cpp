@@ -106,7 +106,7 @@ int run_sweep(const SweepArgs& args) {
   if (!args.csv.empty()) csv_file = StreamingOutput(args.csv, "--csv");
   require_threads(args.threads);
   const auto path = keyframe_path(scene, args.from, args.to, args.waypoints);
-  // Issue #9: the nominal path is checked first; a sweep bounds the straight path only.
+  // The nominal path is checked first; a sweep bounds the straight path only.
   if (const auto checked = check_path(scene, path); !checked.free()) {
     std::cerr << "leeway: collision: " << scene.source() << ": the straight path from " << args.from << " to "
               << args.to

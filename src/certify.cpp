@@ -19,6 +19,7 @@ struct Cell {
   Eigen::VectorXd lower, upper;
   int depth = 0;
   std::vector<int> pairs;
+  int split = -1;  // the joint to split next (set when the cell waits in the heap)
 };
 
 Eigen::Vector3d vec3(const double* p) { return Eigen::Vector3d(p[0], p[1], p[2]); }
@@ -578,7 +579,7 @@ bool Certifier::region_free_impl(const Eigen::VectorXd& lower, const Eigen::Vect
       return false;
     }
     const double key = local.gap;
-    cell.depth = cell.depth * 64 + local.split_joint;  // depth and split joint, unpacked below
+    cell.split = local.split_joint;
     heap.emplace_back(key, std::move(cell));
     std::push_heap(heap.begin(), heap.end(), worse);
     return true;
@@ -590,8 +591,7 @@ bool Certifier::region_free_impl(const Eigen::VectorXd& lower, const Eigen::Vect
     std::pop_heap(heap.begin(), heap.end(), worse);
     Cell cell = std::move(heap.back().second);
     heap.pop_back();
-    const int j = cell.depth % 64;
-    cell.depth /= 64;
+    const int j = cell.split;
     const double mid = (cell.lower[j] + cell.upper[j]) / 2;
     Cell a{cell.lower, cell.upper, cell.depth + 1, cell.pairs};
     Cell b{cell.lower, cell.upper, cell.depth + 1, std::move(cell.pairs)};

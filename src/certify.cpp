@@ -240,8 +240,11 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
   thread_local std::vector<Term> terms;
   bool terms_ready = false;
   thread_local std::vector<double> r_pos,
-      r_rot;                             // per joint p: the remainder terms (p, q >= p) with |n x a_p| = 1
-  thread_local std::vector<double> dv;   // per joint q: |v_q(q) - v_q(c)|, see below
+      r_rot;                            // per joint p: the remainder terms (p, q >= p) with |n x a_p| = 1
+  thread_local std::vector<double> dv;  // per joint q: |v_q(q) - v_q(c)|, see below
+  // r_pos, r_rot and the isotropic terms of the link `full_link` with no joint held.
+  thread_local std::vector<double> full_r_pos, full_r_rot, iso_term;
+  int full_link = -1;
   size_t link_n = 0;                     // the current link's joint count, ...
   double link_theta = 0;                 // ... the rotation all its hinges can give, ...
   int link_index = 0;                    // ... and its index in links_
@@ -326,22 +329,39 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
       // the Jacobian (|d x / d q_p| <= lever_p, 1 for a slide): most pairs are separated by it, and
       // the link's full bound below is built only for the pairs it does not separate.
       const size_t n = link.joints.size();
+      // Term p of these sums involves only joints p and later, so with the first `shared` joints
+      // held (their terms zero) the others are the same as for the whole link: they are built
+      // once per link and leaf, not once per self pair group (a link on a long chain has as many
+      // groups as joints, which made a leaf's cost grow with the fourth power of the joint count).
+      const size_t first = static_cast<size_t>(shared);
+      if (li != full_link) {
+        full_link = li;
+        full_r_pos.assign(n, 0.0);
+        full_r_rot.assign(n, 0.0);
+        iso_term.assign(n, 0.0);
+        for (size_t p = 0; p < n; ++p) {
+          const int rp = link.joints[p];
+          const bool slide_p = prismatic_[static_cast<size_t>(rp)];
+          iso_term[p] = h[rp] * (slide_p ? 1.0 : link.lever[p]);
+          if (slide_p) continue;
+          for (size_t q = p; q < n; ++q) {
+            const int rq = link.joints[q];
+            const bool slide = prismatic_[static_cast<size_t>(rq)];
+            const double coef = (p == q ? 0.5 : 1.0) * h[rp] * h[rq];
+            full_r_pos[p] += coef * (slide ? 1.0 : link.lever[q]);
+            if (!slide) full_r_rot[p] += coef;
+          }
+        }
+      }
       rem_iso = 0;
       r_pos.assign(n, 0.0);
       r_rot.assign(n, 0.0);
       iso_cheap = box.half_size.norm();
-      for (size_t p = 0; p < n; ++p) {
-        const int rp = link.joints[p];
-        const bool slide_p = prismatic_[static_cast<size_t>(rp)];
-        iso_cheap += hl[rp] * (slide_p ? 1.0 : link.lever[p]);
-        if (slide_p) continue;
-        for (size_t q = p; q < n; ++q) {
-          const int rq = link.joints[q];
-          const bool slide = prismatic_[static_cast<size_t>(rq)];
-          const double coef = (p == q ? 0.5 : 1.0) * hl[rp] * hl[rq];
-          r_pos[p] += coef * (slide ? 1.0 : link.lever[q]);
-          if (!slide) r_rot[p] += coef;
-        }
+      for (size_t p = first; p < n; ++p) {
+        iso_cheap += iso_term[p];
+        if (prismatic_[static_cast<size_t>(link.joints[p])]) continue;
+        r_pos[p] = full_r_pos[p];
+        r_rot[p] = full_r_rot[p];
         rem_iso += r_pos[p];
       }
       iso_cheap += rem_iso;

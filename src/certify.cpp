@@ -592,7 +592,8 @@ bool Certifier::region_free_impl(const Eigen::VectorXd& lower, const Eigen::Vect
   auto test = [&](Cell cell) {
     stats.max_depth = std::max(stats.max_depth, cell.depth);
     if (leaf_free_impl(cell.lower, cell.upper, cell.pairs, stats, &local)) return true;
-    const bool exhausted = stats.leaves - start >= budget || cell.depth >= options_.max_depth;
+    const bool exhausted = stats.leaves - start >= budget || stats.leaves >= options_.leaf_limit ||
+                           cell.depth >= options_.max_depth;
     if (local.split_joint < 0 || exhausted || local.centre_hits) {
       local.budget = exhausted && local.split_joint >= 0;
       if (failure) *failure = local;
@@ -604,6 +605,15 @@ bool Certifier::region_free_impl(const Eigen::VectorXd& lower, const Eigen::Vect
     std::push_heap(heap.begin(), heap.end(), worse);
     return true;
   };
+  if (stats.leaves >= options_.leaf_limit) {
+    if (failure) {
+      *failure = CertifyFailure{};
+      failure->lower = lower;
+      failure->upper = upper;
+      failure->budget = true;
+    }
+    return false;
+  }
   Cell root{lower, upper, 0, {}};
   root.pairs = pairs;
   if (!test(std::move(root))) return false;
@@ -644,6 +654,16 @@ bool Certifier::probe(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper
       }
       for (size_t m = 0; m < moving.size(); ++m)
         p[moving[m]] = (bits >> m) & 1 ? upper[moving[m]] : lower[moving[m]];
+    }
+    if (stats.leaves >= options_.leaf_limit) {
+      // Out of work: not a collision, so no centre_hits; the region is simply not shown free.
+      if (failure) {
+        *failure = CertifyFailure{};
+        failure->lower = lower;
+        failure->upper = upper;
+        failure->budget = true;
+      }
+      return false;
     }
     std::vector<int> pairs = all_pairs_;
     const Eigen::VectorXd offsets = (p - nominal).cwiseAbs();
@@ -739,7 +759,8 @@ bool Certifier::segment_free(const Eigen::VectorXd& lower_a, const Eigen::Vector
       stack.push_back({t0, tm});
       continue;
     }
-    const long remaining = options_.max_leaves - (stats.leaves - start);
+    const long remaining =
+        std::min(options_.max_leaves - (stats.leaves - start), options_.leaf_limit - stats.leaves);
     if (remaining <= 0) {
       if (failure) {
         failure->lower = lo;

@@ -46,6 +46,19 @@ void check_box(const Scene& scene, const Eigen::VectorXd& lower, const Eigen::Ve
                        "] are not finite or not ordered");
 }
 
+// The caller's leaf limit (CertifyOptions::leaf_limit) is reached: false, with `failure` saying
+// that the region was not shown free for want of work (budget), not for a collision (no
+// centre_hits, no pair).
+bool out_of_leaves(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, CertifyFailure* failure) {
+  if (failure) {
+    *failure = CertifyFailure{};
+    failure->lower = lower;
+    failure->upper = upper;
+    failure->budget = true;
+  }
+  return false;
+}
+
 }  // namespace
 
 void CertifyStats::add(const CertifyStats& o) {
@@ -605,15 +618,7 @@ bool Certifier::region_free_impl(const Eigen::VectorXd& lower, const Eigen::Vect
     std::push_heap(heap.begin(), heap.end(), worse);
     return true;
   };
-  if (stats.leaves >= options_.leaf_limit) {
-    if (failure) {
-      *failure = CertifyFailure{};
-      failure->lower = lower;
-      failure->upper = upper;
-      failure->budget = true;
-    }
-    return false;
-  }
+  if (stats.leaves >= options_.leaf_limit) return out_of_leaves(lower, upper, failure);
   Cell root{lower, upper, 0, {}};
   root.pairs = pairs;
   if (!test(std::move(root))) return false;
@@ -655,16 +660,7 @@ bool Certifier::probe(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper
       for (size_t m = 0; m < moving.size(); ++m)
         p[moving[m]] = (bits >> m) & 1 ? upper[moving[m]] : lower[moving[m]];
     }
-    if (stats.leaves >= options_.leaf_limit) {
-      // Out of work: not a collision, so no centre_hits; the region is simply not shown free.
-      if (failure) {
-        *failure = CertifyFailure{};
-        failure->lower = lower;
-        failure->upper = upper;
-        failure->budget = true;
-      }
-      return false;
-    }
+    if (stats.leaves >= options_.leaf_limit) return out_of_leaves(lower, upper, failure);
     std::vector<int> pairs = all_pairs_;
     const Eigen::VectorXd offsets = (p - nominal).cwiseAbs();
     if (leaf_free_impl(p, p, pairs, stats, &local, &offsets)) continue;

@@ -67,6 +67,8 @@ nlohmann::json safety_json(const Scene& scene, const SafetyReport& report, const
     if (report.mode == SafetyMode::kCertified) {
       j["leaves"] = s.leaves;
       j["max_depth"] = s.max_depth;
+      // Only when it happened: the key is new, and older files never ran out this way.
+      if (s.budget_exhausted) j["budget_exhausted"] = true;
     } else {
       j["samples"] = s.samples;
       j["rounds"] = s.rounds;

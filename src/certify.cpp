@@ -19,6 +19,7 @@ struct Cell {
   Eigen::VectorXd lower, upper;
   int depth = 0;
   std::vector<int> pairs;
+  int split = -1;  // the joint to split next (set when the cell waits in the heap)
 };
 
 Eigen::Vector3d vec3(const double* p) { return Eigen::Vector3d(p[0], p[1], p[2]); }
@@ -43,6 +44,19 @@ void check_box(const Scene& scene, const Eigen::VectorXd& lower, const Eigen::Ve
       throw InputError("certify: joint '" + scene.joints()[static_cast<size_t>(i)].name + "' bounds [" +
                        format_number(lower[i]) + ", " + format_number(upper[i]) +
                        "] are not finite or not ordered");
+}
+
+// The caller's leaf limit (CertifyOptions::leaf_limit) is reached: false, with `failure` saying
+// that the region was not shown free for want of work (budget), not for a collision (no
+// centre_hits, no pair).
+bool out_of_leaves(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, CertifyFailure* failure) {
+  if (failure) {
+    *failure = CertifyFailure{};
+    failure->lower = lower;
+    failure->upper = upper;
+    failure->budget = true;
+  }
+  return false;
 }
 
 }  // namespace
@@ -239,8 +253,11 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
   thread_local std::vector<Term> terms;
   bool terms_ready = false;
   thread_local std::vector<double> r_pos,
-      r_rot;                             // per joint p: the remainder terms (p, q >= p) with |n x a_p| = 1
-  thread_local std::vector<double> dv;   // per joint q: |v_q(q) - v_q(c)|, see below
+      r_rot;                            // per joint p: the remainder terms (p, q >= p) with |n x a_p| = 1
+  thread_local std::vector<double> dv;  // per joint q: |v_q(q) - v_q(c)|, see below
+  // r_pos, r_rot and the isotropic terms of the link `full_link` with no joint held.
+  thread_local std::vector<double> full_r_pos, full_r_rot, iso_term;
+  int full_link = -1;
   size_t link_n = 0;                     // the current link's joint count, ...
   double link_theta = 0;                 // ... the rotation all its hinges can give, ...
   int link_index = 0;                    // ... and its index in links_
@@ -325,22 +342,39 @@ bool Certifier::leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::Vector
       // the Jacobian (|d x / d q_p| <= lever_p, 1 for a slide): most pairs are separated by it, and
       // the link's full bound below is built only for the pairs it does not separate.
       const size_t n = link.joints.size();
+      // Term p of these sums involves only joints p and later, so with the first `shared` joints
+      // held (their terms zero) the others are the same as for the whole link: they are built
+      // once per link and leaf, not once per self pair group (a link on a long chain has as many
+      // groups as joints, which made a leaf's cost grow with the fourth power of the joint count).
+      const size_t first = static_cast<size_t>(shared);
+      if (li != full_link) {
+        full_link = li;
+        full_r_pos.assign(n, 0.0);
+        full_r_rot.assign(n, 0.0);
+        iso_term.assign(n, 0.0);
+        for (size_t p = 0; p < n; ++p) {
+          const int rp = link.joints[p];
+          const bool slide_p = prismatic_[static_cast<size_t>(rp)];
+          iso_term[p] = h[rp] * (slide_p ? 1.0 : link.lever[p]);
+          if (slide_p) continue;
+          for (size_t q = p; q < n; ++q) {
+            const int rq = link.joints[q];
+            const bool slide = prismatic_[static_cast<size_t>(rq)];
+            const double coef = (p == q ? 0.5 : 1.0) * h[rp] * h[rq];
+            full_r_pos[p] += coef * (slide ? 1.0 : link.lever[q]);
+            if (!slide) full_r_rot[p] += coef;
+          }
+        }
+      }
       rem_iso = 0;
       r_pos.assign(n, 0.0);
       r_rot.assign(n, 0.0);
       iso_cheap = box.half_size.norm();
-      for (size_t p = 0; p < n; ++p) {
-        const int rp = link.joints[p];
-        const bool slide_p = prismatic_[static_cast<size_t>(rp)];
-        iso_cheap += hl[rp] * (slide_p ? 1.0 : link.lever[p]);
-        if (slide_p) continue;
-        for (size_t q = p; q < n; ++q) {
-          const int rq = link.joints[q];
-          const bool slide = prismatic_[static_cast<size_t>(rq)];
-          const double coef = (p == q ? 0.5 : 1.0) * hl[rp] * hl[rq];
-          r_pos[p] += coef * (slide ? 1.0 : link.lever[q]);
-          if (!slide) r_rot[p] += coef;
-        }
+      for (size_t p = first; p < n; ++p) {
+        iso_cheap += iso_term[p];
+        if (prismatic_[static_cast<size_t>(link.joints[p])]) continue;
+        r_pos[p] = full_r_pos[p];
+        r_rot[p] = full_r_rot[p];
         rem_iso += r_pos[p];
       }
       iso_cheap += rem_iso;
@@ -571,18 +605,20 @@ bool Certifier::region_free_impl(const Eigen::VectorXd& lower, const Eigen::Vect
   auto test = [&](Cell cell) {
     stats.max_depth = std::max(stats.max_depth, cell.depth);
     if (leaf_free_impl(cell.lower, cell.upper, cell.pairs, stats, &local)) return true;
-    const bool exhausted = stats.leaves - start >= budget || cell.depth >= options_.max_depth;
+    const bool exhausted = stats.leaves - start >= budget || stats.leaves >= options_.leaf_limit ||
+                           cell.depth >= options_.max_depth;
     if (local.split_joint < 0 || exhausted || local.centre_hits) {
       local.budget = exhausted && local.split_joint >= 0;
       if (failure) *failure = local;
       return false;
     }
     const double key = local.gap;
-    cell.depth = cell.depth * 64 + local.split_joint;  // depth and split joint, unpacked below
+    cell.split = local.split_joint;
     heap.emplace_back(key, std::move(cell));
     std::push_heap(heap.begin(), heap.end(), worse);
     return true;
   };
+  if (stats.leaves >= options_.leaf_limit) return out_of_leaves(lower, upper, failure);
   Cell root{lower, upper, 0, {}};
   root.pairs = pairs;
   if (!test(std::move(root))) return false;
@@ -590,8 +626,7 @@ bool Certifier::region_free_impl(const Eigen::VectorXd& lower, const Eigen::Vect
     std::pop_heap(heap.begin(), heap.end(), worse);
     Cell cell = std::move(heap.back().second);
     heap.pop_back();
-    const int j = cell.depth % 64;
-    cell.depth /= 64;
+    const int j = cell.split;
     const double mid = (cell.lower[j] + cell.upper[j]) / 2;
     Cell a{cell.lower, cell.upper, cell.depth + 1, cell.pairs};
     Cell b{cell.lower, cell.upper, cell.depth + 1, std::move(cell.pairs)};
@@ -625,6 +660,7 @@ bool Certifier::probe(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper
       for (size_t m = 0; m < moving.size(); ++m)
         p[moving[m]] = (bits >> m) & 1 ? upper[moving[m]] : lower[moving[m]];
     }
+    if (stats.leaves >= options_.leaf_limit) return out_of_leaves(lower, upper, failure);
     std::vector<int> pairs = all_pairs_;
     const Eigen::VectorXd offsets = (p - nominal).cwiseAbs();
     if (leaf_free_impl(p, p, pairs, stats, &local, &offsets)) continue;
@@ -719,7 +755,8 @@ bool Certifier::segment_free(const Eigen::VectorXd& lower_a, const Eigen::Vector
       stack.push_back({t0, tm});
       continue;
     }
-    const long remaining = options_.max_leaves - (stats.leaves - start);
+    const long remaining =
+        std::min(options_.max_leaves - (stats.leaves - start), options_.leaf_limit - stats.leaves);
     if (remaining <= 0) {
       if (failure) {
         failure->lower = lo;

@@ -166,10 +166,18 @@ SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& g
       target_above_b = e.above[b];
     }
   }
+  // Every call below counts its leaves in `stats`, which the certifier's leaf_limit (the segment's
+  // budget) caps: a call that reaches it fails with f.budget set.
+  const auto out_of_budget = [&] { return stats.leaves >= certifier.options().leaf_limit; };
   while (s.shrink_steps < kMaxShrinkSteps) {
     CertifyFailure f;
     if (probed(a, b, &f) && certified(a, b, &f)) {
       s.passed = true;
+      break;
+    }
+    if (out_of_budget()) {
+      // Shrinking further would prove nothing more: the segment is not certified.
+      s.budget_exhausted = true;
       break;
     }
     ++s.shrink_steps;
@@ -217,9 +225,9 @@ SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& g
     std::vector<size_t> ends;
     if (s.shrink_steps > 0) ends.push_back(a);
     if (b != a) ends.push_back(b);
-    for (int i = 0; i < n; ++i)
+    for (int i = 0; i < n && !out_of_budget(); ++i)
       for (size_t k : ends)
-        for (int side = 0; side < 2; ++side) {
+        for (int side = 0; side < 2 && !out_of_budget(); ++side) {
           double& extent = side ? e.above[k][i] : e.below[k][i];
           const double shrunk_to = extent,
                        guide_extent = k == b ? (side ? target_above_b[i] : target_below_b[i])
@@ -270,6 +278,8 @@ SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& g
           extent = ok;
         }
   }
+  // (A regrow step that ran out kept the extent it had proven: the segment stays certified.)
+  if (out_of_budget()) s.budget_exhausted = true;
   s.leaves = stats.leaves;
   s.max_depth = stats.max_depth;
   total.add(stats);
@@ -316,6 +326,10 @@ SegmentSafety sample_segment(RobotState& state, Extents& e, size_t a, size_t b, 
 
 }  // namespace
 
+long segment_leaf_budget(const SafetyParams& params) {
+  return kSegmentLeafBudgetFactor * static_cast<long>(params.max_leaves);
+}
+
 long sampled_test_size(double epsilon, double delta) {
   return static_cast<long>(std::ceil(std::log(1.0 / delta) / epsilon));
 }
@@ -339,6 +353,8 @@ SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, 
     options.margin = params.margin;
     options.max_leaves = params.max_leaves;
     options.bound = bound;
+    // Each segment counts its leaves from zero (certify_segment's own CertifyStats).
+    options.leaf_limit = segment_leaf_budget(params);
     const Extents guide(bounds);
     // Segment s writes waypoints s and s + 1 and, regrowing them, reads its neighbours' (s - 1 and
     // s + 2): segments three apart share nothing, so the segments with s % phases == phase run in

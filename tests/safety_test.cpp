@@ -134,6 +134,91 @@ TEST_F(OneLinkSafetyTest, ADensePathWidensAgainWhereItsGuideWidens) {
   }
 }
 
+// A serial chain of n hinges (about z and y in turn, 1.6 m in all, a 6 cm box per link) on a fixed
+// base, as tools/chain_cell.py writes it, with a wall 0.85 m to its side; keyframes a (straight)
+// and b (bent).
+std::string chain_cell(int n) {
+  const double seg = 1.6 / n;
+  std::string bodies, closing, straight, bent;
+  for (int i = 0; i < n; ++i) {
+    bodies += "<body name=\"l" + std::to_string(i + 1) + "\" pos=\"0 0 " +
+              (i == 0 ? "0.2" : std::to_string(seg)) + "\"><joint name=\"j" + std::to_string(i + 1) +
+              "\" type=\"hinge\" axis=\"" + (i % 2 ? "0 1 0" : "0 0 1") +
+              "\" range=\"-3 3\" user=\"1.5\"/><geom name=\"g" + std::to_string(i + 1) +
+              "\" type=\"box\" size=\"0.03 0.03 " + std::to_string(0.4 * seg) + "\" pos=\"0 0 " +
+              std::to_string(0.5 * seg) + "\"/>\n";
+    closing += "</body>";
+    straight += " 0";
+    bent += i % 2 ? " 0.02" : " 0";
+  }
+  return R"(<mujoco model="chain">
+  <compiler angle="radian" autolimits="true"/>
+  <worldbody>
+    <body name="base"><geom name="base_box" type="box" size="0.1 0.1 0.1" pos="0 0 0.1"/>
+)" + bodies +
+         "<site name=\"tool0\" pos=\"0 0 " + std::to_string(seg) + "\"/>" + closing + R"(</body>
+    <geom name="wall" type="box" size="0.05 1 1" pos="0.9 0 1" contype="0" conaffinity="1"/>
+  </worldbody>
+  <keyframe><key name="a" qpos=")" +
+         straight.substr(1) + R"("/><key name="b" qpos=")" + bent.substr(1) + R"("/></keyframe>
+</mujoco>
+)";
+}
+
+TEST(SafetyBudgetTest, ALongChainStopsAtTheSegmentBudgetAndIsNotCertified) {
+  // Every leaf of a 60-joint chain tests about 1,800 pairs, and the repair would take one test per
+  // shrink step and several per joint when regrowing: the segment's budget (128 x max_leaves, probe
+  // checks included) must cap all of it, and a segment that runs out before its proof keeps its
+  // nominal values and is not certified.
+  test::TempDir dir;
+  const Scene scene = Scene::load(dir.write("chain.xml", chain_cell(60)));
+  ASSERT_EQ(scene.dof(), 60);
+  WaypointBounds a, b;
+  a.q = Eigen::VectorXd::Zero(60);
+  b.q = a.q;
+  for (int i = 1; i < 60; i += 2) b.q[i] = 0.02;
+  for (WaypointBounds* w : {&a, &b}) {
+    w->lower = w->q.array() - 0.2;
+    w->upper = w->q.array() + 0.2;
+    w->guide_lower = w->lower;
+    w->guide_upper = w->upper;
+    w->collapsed.assign(60, false);
+  }
+  std::vector<WaypointBounds> bounds = {a, b};
+  SafetyParams params;
+  params.max_leaves = 2;
+  ASSERT_EQ(segment_leaf_budget(params), 256);
+  const SafetyReport r = make_safe(scene, bounds, params);
+  ASSERT_EQ(r.segments.size(), 1u);
+  EXPECT_FALSE(r.all_passed);
+  EXPECT_FALSE(r.segments[0].passed);
+  EXPECT_TRUE(r.segments[0].budget_exhausted);
+  EXPECT_LE(r.stats.leaves, segment_leaf_budget(params));
+  EXPECT_EQ(r.segments[0].leaves, r.stats.leaves);
+  for (const auto& w : bounds) {
+    EXPECT_EQ(w.lower, w.q);
+    EXPECT_EQ(w.upper, w.q);
+  }
+}
+
+TEST(SafetyBudgetTest, TheBoundsFileAndSummarySayTheBudgetRanOut) {
+  test::TempDir dir;
+  const std::string cell = dir.write("chain.xml", chain_cell(12));
+  const std::string params = dir.write("p.json", R"({"safety": {"max_leaves": 1}})");
+  const auto out = dir.path() / "b.json";
+  const auto r = run_cli("bounds " + cell + " --from a --to b --threads 1 --params " + params + " --out " +
+                         out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_THAT(r.out,
+              HasSubstr("NOT CERTIFIED where the nominal path is too close or the leaf budget ran out"));
+  EXPECT_THAT(r.out,
+              HasSubstr("the leaf budget (128 per segment, 128 x safety.max_leaves) ran out on 1 of 1"));
+  const json j = read_json(out);
+  EXPECT_FALSE(j["safety"]["certified"].get<bool>());
+  EXPECT_TRUE(j["safety"]["segments"][0]["budget_exhausted"].get<bool>());
+  EXPECT_LE(j["safety"]["leaves"].get<long>(), 128);
+}
+
 TEST_F(OneLinkSafetyTest, NoneLeavesTheBoundsAsTheyAre) {
   std::vector<WaypointBounds> bounds = {box_around(0.0, -0.5, 2.0), box_around(0.3, -0.2, 2.0)};
   SafetyParams p;

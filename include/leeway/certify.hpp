@@ -7,6 +7,7 @@
 //! conservative.
 
 #include <Eigen/Core>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,9 @@ struct CertifyOptions {
   long max_leaves = 16384;  //!< leaf budget of one region (or one segment); beyond it: not certified
   int max_depth = 40;       //!< deepest subdivision of one region
   CertifyBound bound = CertifyBound::kTaylor;
+  //! The caller's work limit across calls: no call lets the CertifyStats it is given count more than
+  //! this many leaves (probe checks included); a call that reaches it fails with `budget` set.
+  long leaf_limit = std::numeric_limits<long>::max();
 };
 
 //! Counters of certification work.

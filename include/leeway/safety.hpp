@@ -23,7 +23,20 @@ struct SegmentSafety {
   long samples = 0;      //!< sampled mode: configurations drawn, all rounds and passes
   int rounds =
       0;  //!< sampled mode: sampling rounds, all passes (the last one found no collision when passed)
+  //! Certified mode: the segment's leaf budget (segment_leaf_budget) ran out. Before the segment was
+  //! proven, it is not certified and keeps its nominal values; after (while regrowing), it keeps
+  //! the bounds proven so far, narrower than the search would have made them.
+  bool budget_exhausted = false;
 };
+
+//! The certified mode's work limit per segment, in multiples of SafetyParams::max_leaves: every
+//! leaf the segment costs (probe checks, the proofs of every shrink step, the regrow's probes and
+//! slabs, its neighbours' slabs included) counts. The stage as a whole spends at most this times
+//! max_leaves times the number of segments, whatever the joint count.
+constexpr long kSegmentLeafBudgetFactor = 128;
+
+//! The leaf budget of one segment: kSegmentLeafBudgetFactor * max_leaves.
+long segment_leaf_budget(const SafetyParams& params);
 
 //! What the safety stage did.
 struct SafetyReport {

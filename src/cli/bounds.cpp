@@ -34,7 +34,11 @@ std::string shrink_note(const WaypointBounds& w, int i) {
 // One line on the safety stage: mode, outcome, work.
 void print_safety(const SafetyReport& r, const SafetyParams& params) {
   int passed = 0;
-  for (const auto& s : r.segments) passed += s.passed ? 1 : 0;
+  int exhausted = 0;
+  for (const auto& s : r.segments) {
+    passed += s.passed ? 1 : 0;
+    exhausted += s.budget_exhausted ? 1 : 0;
+  }
   const auto n = r.segments.size();
   switch (r.mode) {
     case SafetyMode::kNone:
@@ -44,7 +48,17 @@ void print_safety(const SafetyReport& r, const SafetyParams& params) {
       std::cout << "safety: certified, " << passed << " of " << n
                 << " segments proven free of the cell and of itself (margin " << format_number(params.margin)
                 << " m; " << r.stats.leaves << " leaves, depth " << r.stats.max_depth << ")"
-                << (r.all_passed ? "" : "; NOT CERTIFIED where the nominal path is too close") << "\n";
+                << (r.all_passed ? ""
+                    : exhausted > 0
+                        ? "; NOT CERTIFIED where the nominal path is too close or the leaf budget ran out"
+                        : "; NOT CERTIFIED where the nominal path is too close")
+                << "\n";
+      if (exhausted > 0)
+        std::cout
+            << "safety: the leaf budget (" << segment_leaf_budget(params) << " per segment, "
+            << kSegmentLeafBudgetFactor << " x safety.max_leaves) ran out on " << exhausted << " of " << n
+            << " segments (NOT CERTIFIED where it ran out before the proof, narrower bounds where it ran "
+               "out while regrowing)\n";
       break;
     case SafetyMode::kSampled:
       std::cout << "safety: sampled, " << passed << " of " << n << " segments passed "

@@ -55,8 +55,11 @@ TEST(TempFileTest, IsANewHiddenRegularFileBesideTheTargetWithAnUnpredictableName
     EXPECT_EQ(p.filename().string().rfind(".out.json.", 0), 0u) << p;
     EXPECT_EQ(p.filename().string().size(), std::string(".out.json.").size() + 12) << p;
     EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(p)));
-    // Not the PID: another user could plant a link at a name derived from it.
-    EXPECT_EQ(p.filename().string().find(std::to_string(::getpid())), std::string::npos) << p;
+    // Twelve random hex digits, not the PID (another user could plant a link at a name derived from
+    // it). The digits may happen to contain the PID's: only the old ".tmpPID" form is ruled out.
+    const std::string suffix = p.filename().string().substr(std::string(".out.json.").size());
+    EXPECT_EQ(suffix.find_first_not_of("0123456789abcdef"), std::string::npos) << p;
+    EXPECT_NE(suffix, "tmp" + std::to_string(::getpid())) << p;
     names.insert(p.filename().string());
   }
   EXPECT_EQ(names.size(), 20u);

@@ -21,10 +21,10 @@ void require_bounds_shape(const nlohmann::json& j, const std::string& path) {
   if (j.contains("format") && !is_bounds_format(j.at("format")))
     throw InputError(path + ": not a leeway bounds file: format " + j.at("format").dump() +
                      " (leeway reads " + kBoundsFormat + " and " + kBoundsFormat1 + ")");
+  if (j.contains("joints") && j.contains("waypoints")) return;  // older files have no 'format'
   std::string missing;
   for (const char* key : {"format", "joints", "waypoints"})
     if (!j.contains(key)) missing += std::string(missing.empty() ? "no '" : ", no '") + key + "'";
-  if (j.contains("joints") && j.contains("waypoints")) return;  // older files have no 'format'
   throw InputError(path + ": not a leeway bounds file: " + missing + " (a bounds file has " + expected + ")");
 }
 

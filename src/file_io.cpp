@@ -179,11 +179,12 @@ void require_outputs(const std::vector<OutputFile>& outputs, const std::vector<s
       throw InputError(named + ": cannot write there (folder '" + folder.string() +
                        "' missing or not writable)");
     // A name the folder cannot hold would fail only when the finished file is moved into place.
-    const long name_max = ::pathconf(folder.c_str(), _PC_NAME_MAX);
+    const long queried = ::pathconf(folder.c_str(), _PC_NAME_MAX);
+    const size_t name_max = queried > 0 ? static_cast<size_t>(queried) : 255;
     const size_t name_bytes = fs::path(o.path).filename().string().size();
-    if (name_bytes > static_cast<size_t>(name_max > 0 ? name_max : 255))
+    if (name_bytes > name_max)
       throw InputError(named + ": the file name has " + std::to_string(name_bytes) + " bytes; folder '" +
-                       folder.string() + "' allows at most " + std::to_string(name_max > 0 ? name_max : 255));
+                       folder.string() + "' allows at most " + std::to_string(name_max));
     if (fs::absolute(o.path, ec).string().size() >= PATH_MAX)
       throw InputError(named + ": the path is longer than the system allows (" +
                        std::to_string(PATH_MAX - 1) + " bytes)");

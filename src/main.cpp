@@ -23,6 +23,7 @@
 #include "cli/plot.hpp"
 #include "cli/render.hpp"
 #include "cli/sample.hpp"
+#include "cli/simulate.hpp"
 #include "cli/sweep.hpp"
 #include "leeway/error.hpp"
 #include "leeway/file_io.hpp"
@@ -52,6 +53,7 @@ int main(int argc, char** argv) {
   RenderArgs render;
   PlotArgs plot;
   BatchArgs batch;
+  SimulateArgs simulate;
   // In the order of `leeway --help`.
   const std::vector<std::pair<CLI::App*, std::function<int()>>> commands = {
       {add_check(app, check), [&] { return run_check(check); }},
@@ -61,6 +63,7 @@ int main(int argc, char** argv) {
       {add_bounds(app, bounds), [&] { return run_bounds(bounds); }},
       {add_cf(app, cf), [&] { return run_cf(cf); }},
       {add_sample(app, sample), [&] { return run_sample(sample); }},
+      {add_simulate(app, simulate), [&] { return run_simulate(simulate); }},
       {add_sweep(app, sweep), [&] { return run_sweep(sweep); }},
       {add_params(app, params), [&] { return run_params(params); }},
       {add_import_urdf(app, import_urdf), [&] { return run_import_urdf(import_urdf); }},

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 
 #include "json_io.hpp"
@@ -226,6 +227,105 @@ bool project_point(const RenderCamera& camera, double fovy, int width, int heigh
   return true;
 }
 
+namespace {
+
+void mark_transparent(mjvGeom& g, const Eigen::Vector3d& campos) {
+  g.transparent = 1;
+  g.camdist = static_cast<float>((Eigen::Vector3d(g.pos[0], g.pos[1], g.pos[2]) - campos).norm());
+}
+
+// A ghost: the robot's moving geoms at the pose in `d`, translucent and tinted (lower-bound ghosts
+// bluish, upper-bound ones reddish).
+void add_ghost(const mjModel& m, mjData& d, mjvOption& opt, const Eigen::Vector3d& campos, bool lower,
+               mjvScene& scn) {
+  const int first = scn.ngeom;
+  mjv_addGeoms(&m, &d, &opt, nullptr, mjCAT_DYNAMIC, &scn);
+  for (int k = first; k < scn.ngeom; ++k) {
+    mjvGeom& geom = scn.geoms[k];
+    if (geom.objtype != mjOBJ_GEOM) {  // sites and decor of the ghost: leave them out
+      geom.rgba[3] = 0;
+      continue;
+    }
+    geom.rgba[0] = lower ? 0.35f : 0.95f;
+    geom.rgba[1] = lower ? 0.60f : 0.35f;
+    geom.rgba[2] = lower ? 0.95f : 0.35f;
+    geom.rgba[3] = 0.28f;
+    geom.segid = -1;
+    mark_transparent(geom, campos);
+  }
+}
+
+void set_camera(const RenderCamera& c, mjvCamera& cam) {
+  mjv_defaultCamera(&cam);
+  cam.type = mjCAMERA_FREE;
+  cam.azimuth = c.azimuth * 180 / kPi;
+  cam.elevation = c.elevation * 180 / kPi;
+  cam.distance = c.distance;
+  for (int k = 0; k < 3; ++k) cam.lookat[k] = c.lookat[k];
+}
+
+}  // namespace
+
+struct FrameRenderer::Impl {
+  const Scene& scene;
+  ModelPtr model;
+  DataPtr data, ghost;
+  mjvOption opt;
+  mjvCamera cam;
+  mjvScene scn;
+  std::unique_ptr<detail::OffscreenContext> gl;
+  Impl(const Scene& s) : scene(s) {}
+  ~Impl() { mjv_freeScene(&scn); }
+};
+
+FrameRenderer::FrameRenderer(const Scene& scene, int width, int height, const RenderCamera& camera)
+    : impl_(std::make_unique<Impl>(scene)) {
+  detail::check_image_size(width, height, "video size");
+  check_camera(camera);
+  install_mujoco_error_handlers();
+  Impl& r = *impl_;
+  r.model.reset(mj_copyModel(nullptr, &scene.model()));
+  if (!r.model) throw std::runtime_error("MuJoCo could not copy the cell's model");
+  r.data = make_data(*r.model);
+  r.ghost = make_data(*r.model);
+  mjv_defaultOption(&r.opt);
+  set_camera(camera, r.cam);
+  mjv_defaultScene(&r.scn);
+  mjv_makeScene(r.model.get(), &r.scn, 1000 + 3 * (r.model->ngeom + r.model->nsite + 16));
+  r.gl = std::make_unique<detail::OffscreenContext>(*r.model, width, height);
+}
+
+FrameRenderer::~FrameRenderer() = default;
+
+Image FrameRenderer::render(const Eigen::VectorXd& q, const std::vector<Eigen::VectorXd>& ghosts,
+                            const Eigen::Vector3d& arrow_from, const Eigen::Vector3d& arrow) {
+  Impl& r = *impl_;
+  const mjModel& m = *r.model;
+  r.scene.validate_configuration(q, "rendered configuration");
+  r.scene.set_qpos(*r.data, q);
+  mj_kinematics(&m, r.data.get());
+  mj_camlight(&m, r.data.get());
+  mjv_updateScene(&m, r.data.get(), &r.opt, nullptr, &r.cam, mjCAT_ALL, &r.scn);
+  const Eigen::Vector3d campos(r.scn.camera[0].pos[0], r.scn.camera[0].pos[1], r.scn.camera[0].pos[2]);
+  for (size_t i = 0; i < ghosts.size() && i < 2; ++i) {
+    r.scene.set_qpos(*r.ghost, ghosts[i]);
+    mj_kinematics(&m, r.ghost.get());
+    add_ghost(m, *r.ghost, r.opt, campos, i % 2 == 0, r.scn);
+  }
+  if (arrow.norm() > 1e-6 && r.scn.ngeom < r.scn.maxgeom) {
+    mjvGeom& g = r.scn.geoms[r.scn.ngeom++];
+    g = mjvGeom{};
+    const float rgba[4] = {0.1f, 0.85f, 0.2f, 1.0f};
+    mjv_initGeom(&g, mjGEOM_ARROW, nullptr, nullptr, nullptr, rgba);
+    const Eigen::Vector3d to = arrow_from + arrow;
+    mjv_makeConnector(&g, mjGEOM_ARROW, 0.08, arrow_from.x(), arrow_from.y(), arrow_from.z(), to.x(), to.y(),
+                      to.z());
+    g.category = mjCAT_DECOR;
+  }
+  mjr_render(r.gl->viewport(), &r.scn, &r.gl->mjr());
+  return r.gl->read();
+}
+
 Image render_scene(const Scene& scene, const RenderRequest& request) {
   detail::check_image_size(request.width, request.height, "image size");
   check_camera(request.camera);
@@ -251,12 +351,7 @@ Image render_scene(const Scene& scene, const RenderRequest& request) {
   mjvOption opt;
   mjv_defaultOption(&opt);
   mjvCamera cam;
-  mjv_defaultCamera(&cam);
-  cam.type = mjCAMERA_FREE;
-  cam.azimuth = request.camera.azimuth * 180 / kPi;
-  cam.elevation = request.camera.elevation * 180 / kPi;
-  cam.distance = request.camera.distance;
-  for (int k = 0; k < 3; ++k) cam.lookat[k] = request.camera.lookat[k];
+  set_camera(request.camera, cam);
 
   const long ghost_geoms = static_cast<long>(request.ghosts.size()) * (m.ngeom + m.nsite + 16);
   const long maxgeom = 1000 + m.ngeom + m.nsite + static_cast<long>(request.volume.size()) + ghost_geoms;
@@ -270,31 +365,10 @@ Image render_scene(const Scene& scene, const RenderRequest& request) {
   } free_scene{&scn};
   mjv_updateScene(&m, data.get(), &opt, nullptr, &cam, mjCAT_ALL, &scn);
   const Eigen::Vector3d campos(scn.camera[0].pos[0], scn.camera[0].pos[1], scn.camera[0].pos[2]);
-  auto mark_transparent = [&campos](mjvGeom& g) {
-    g.transparent = 1;
-    g.camdist = static_cast<float>((Eigen::Vector3d(g.pos[0], g.pos[1], g.pos[2]) - campos).norm());
-  };
 
-  // Ghosts: the robot's moving geoms at each configuration, translucent and tinted (lower-bound
-  // ghosts bluish, upper-bound ones reddish when there are two per joint or corner).
   for (size_t i = 0; i < request.ghosts.size(); ++i) {
     DataPtr g = pose(request.ghosts[i]);
-    const int first = scn.ngeom;
-    mjv_addGeoms(&m, g.get(), &opt, nullptr, mjCAT_DYNAMIC, &scn);
-    const bool lower = i % 2 == 0;
-    for (int k = first; k < scn.ngeom; ++k) {
-      mjvGeom& geom = scn.geoms[k];
-      if (geom.objtype != mjOBJ_GEOM) {  // sites and decor of the ghost: leave them out
-        geom.rgba[3] = 0;
-        continue;
-      }
-      geom.rgba[0] = lower ? 0.35f : 0.95f;
-      geom.rgba[1] = lower ? 0.60f : 0.35f;
-      geom.rgba[2] = lower ? 0.95f : 0.35f;
-      geom.rgba[3] = 0.28f;
-      geom.segid = -1;
-      mark_transparent(geom);
-    }
+    add_ghost(m, *g, opt, campos, i % 2 == 0, scn);
   }
 
   // The volume: one box per volume box, coloured by the height of its top.
@@ -317,7 +391,7 @@ Image render_scene(const Scene& scene, const RenderRequest& request) {
     geom = mjvGeom{};
     mjv_initGeom(&geom, mjGEOM_BOX, size, pos, mat, rgba);
     geom.category = mjCAT_DECOR;
-    if (request.volume_alpha < 1) mark_transparent(geom);
+    if (request.volume_alpha < 1) mark_transparent(geom, campos);
   }
 
   detail::OffscreenContext gl(m, request.width, request.height);

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -79,6 +80,26 @@ std::vector<Eigen::VectorXd> ghost_configurations(const WaypointBounds& w, Ghost
 //! @throws InputError on an image size outside 16 .. 8192 pixels, a non-finite camera or a bad q;
 //! std::runtime_error when no OpenGL context can be made.
 Image render_scene(const Scene& scene, const RenderRequest& request);
+
+//! Renders many frames of one scene through one OpenGL context (a video): the robot at q, up to two
+//! ghosts (tinted as render_scene's) and an arrow. One per thread; the scene must outlive it.
+class FrameRenderer {
+ public:
+  //! @throws InputError on a size outside 16 .. 8192 pixels or a non-finite camera;
+  //! std::runtime_error when no OpenGL context can be made.
+  FrameRenderer(const Scene& scene, int width, int height, const RenderCamera& camera);
+  ~FrameRenderer();
+  FrameRenderer(const FrameRenderer&) = delete;
+  FrameRenderer& operator=(const FrameRenderer&) = delete;
+  //! One frame: the robot at q, the ghosts, and a green arrow from `arrow_from` along `arrow` [m]
+  //! (none when `arrow` is zero).
+  Image render(const Eigen::VectorXd& q, const std::vector<Eigen::VectorXd>& ghosts,
+               const Eigen::Vector3d& arrow_from, const Eigen::Vector3d& arrow);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 //! Projects a world point [m] to pixel coordinates (column, row from the top) of an image rendered
 //! with `camera` and vertical field of view `fovy` [rad]: MuJoCo's free-camera pinhole model. Returns

@@ -1,12 +1,20 @@
 #include "cli/simulate.hpp"
 
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <iomanip>
 #include <iostream>
+#include <memory>
+#include <optional>
 #include <sstream>
 
 #include "leeway/bounds_file.hpp"
 #include "leeway/file_io.hpp"
 #include "leeway/mjcf_source.hpp"
+#include "leeway/render.hpp"
 
 namespace leeway::cli {
 
@@ -96,6 +104,105 @@ HumanOptions human_options(const SimulateArgs& args) {
   return h;
 }
 
+// The path of an executable `name` on PATH, or "".
+std::string find_on_path(const std::string& name) {
+  const char* path = std::getenv("PATH");
+  std::string dirs = path ? path : "";
+  size_t start = 0;
+  while (start <= dirs.size()) {
+    const size_t end = dirs.find(':', start);
+    const std::string dir = dirs.substr(start, end == std::string::npos ? std::string::npos : end - start);
+    const std::string candidate = (dir.empty() ? "." : dir) + "/" + name;
+    if (::access(candidate.c_str(), X_OK) == 0) return candidate;
+    if (end == std::string::npos) break;
+    start = end + 1;
+  }
+  return "";
+}
+
+std::string shell_quote(const std::string& text) {
+  std::string out = "'";
+  for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+// Frames at 30 fps of simulated time, piped as raw RGB into ffmpeg, which writes an H.264 MP4 into
+// a temporary file renamed over the target when it succeeds.
+class VideoWriter {
+ public:
+  VideoWriter(const Scene& scene, const BoundsTrajectory& bounds, const std::string& path, int width,
+              int height, const std::string& ffmpeg)
+      : scene_(scene), temp_(path), width_(width), height_(height) {
+    // The camera frames the tool's reach along the path: around the first hinge's anchor, out to
+    // the farthest nominal tool position plus 1 m.
+    DataPtr d = make_data(scene.model());
+    Eigen::Vector2d base(0, 0);
+    double radius = 1.0;
+    bool have_base = false;
+    for (const auto& w : bounds.waypoints()) {
+      scene.set_qpos(*d, w.q);
+      mj_kinematics(&scene.model(), d.get());
+      if (!have_base)
+        for (const auto& j : scene.joints())
+          if (!j.prismatic) {
+            base = {d->xanchor[3 * j.id], d->xanchor[3 * j.id + 1]};
+            have_base = true;
+            break;
+          }
+      const int site = scene.tool_site();
+      radius = std::max(
+          radius, (Eigen::Vector2d(d->site_xpos[3 * site], d->site_xpos[3 * site + 1]) - base).norm() + 1);
+    }
+    const double fovy = scene.model().vis.global.fovy * 3.14159265358979323846 / 180;
+    renderer_ = std::make_unique<FrameRenderer>(scene, width, height, frame_circle(base, radius, 2.5, fovy));
+    const std::string command =
+        shell_quote(ffmpeg) + " -hide_banner -loglevel error -y -f rawvideo -pix_fmt rgb24 -s " +
+        std::to_string(width) + "x" + std::to_string(height) +
+        " -r 30 -i - -an -c:v libx264 -pix_fmt yuv420p -f mp4 " + shell_quote(temp_.path());
+    pipe_ = ::popen(command.c_str(), "w");
+    if (!pipe_) throw InputError("--video: could not start " + ffmpeg);
+  }
+  ~VideoWriter() {
+    if (pipe_) ::pclose(pipe_);
+  }
+
+  // Called at every control period: renders a frame whenever 1/30 s of simulated time has passed.
+  void on_frame(const mjModel& m, const mjData& d, const SimFrame& f) {
+    if (failed_ || f.t + 1e-9 < next_) return;
+    next_ += 1.0 / 30;
+    Eigen::VectorXd q(scene_.dof());
+    for (int j = 0; j < scene_.dof(); ++j)
+      q[j] = d.qpos[m.jnt_qposadr[scene_.joints()[static_cast<size_t>(j)].id]];
+    const WaypointBounds box(f.box.nominal, f.box.lower, f.box.upper);
+    // The push as an arrow at the tool, 1 cm per newton.
+    const Image image =
+        renderer_->render(q, ghost_configurations(box, GhostMode::kCorners), f.tool, 0.01 * f.force);
+    if (std::fwrite(image.rgb.data(), 1, image.rgb.size(), pipe_) != image.rgb.size()) failed_ = true;
+    ++frames_;
+  }
+
+  // Ends the stream; returns the frame count. @throws InputError when ffmpeg failed.
+  long finish(const std::string& path) {
+    const int status = ::pclose(pipe_);
+    pipe_ = nullptr;
+    if (failed_ || status != 0)
+      throw InputError("--video " + path + ": ffmpeg failed (exit status " + std::to_string(status) +
+                       "); no video written");
+    temp_.commit();
+    return frames_;
+  }
+
+ private:
+  const Scene& scene_;
+  TempFile temp_;
+  int width_, height_;
+  std::unique_ptr<FrameRenderer> renderer_;
+  FILE* pipe_ = nullptr;
+  double next_ = 0;
+  long frames_ = 0;
+  bool failed_ = false;
+};
+
 void print_report(const Scene& scene, const SimulationReport& r, const SimulateOptions& o) {
   std::ostringstream out;
   out << std::setprecision(4);
@@ -146,15 +253,45 @@ int run_simulate(const SimulateArgs& args) {
   options.controller = args.controller == "projection" ? ControllerKind::kProjection : ControllerKind::kMpc;
   options.check();
 
+  std::optional<std::pair<int, int>> size;
+  std::string ffmpeg;
+  if (!args.video.empty()) {
+    size = parse_size(args.size, "--size");
+    if (size->first % 2 || size->second % 2)
+      throw InputError("--size " + args.size +
+                       ": a video's width and height must be even (H.264 in yuv420p)");
+    ffmpeg = find_on_path("ffmpeg");
+  }
+
   const auto scene = Scene::load(args.cell, scene_options(args.tool));
   const BoundsTrajectory bounds = read_bounds_trajectory(args.bounds, scene);
-  const SimulationReport report = simulate(scene, bounds, options);
-  const nlohmann::json j = simulation_json(scene, report, options, args.cell, args.bounds);
+  std::unique_ptr<VideoWriter> video;
+  if (!args.video.empty() && ffmpeg.empty())
+    std::cerr << "leeway: warning: --video " << args.video
+              << ": ffmpeg is not on PATH (Debian: apt-get install ffmpeg); no video is written, the "
+                 "simulation runs\n";
+  if (!ffmpeg.empty())
+    video = std::make_unique<VideoWriter>(scene, bounds, args.video, size->first, size->second, ffmpeg);
+  FrameCallback on_frame;
+  if (video)
+    on_frame = [&](const mjModel& m, const mjData& d, const SimFrame& f) { video->on_frame(m, d, f); };
+  const SimulationReport report = simulate(scene, bounds, options, on_frame);
+  nlohmann::json j = simulation_json(scene, report, options, args.cell, args.bounds);
+  if (!args.video.empty()) {
+    j["video"] = nullptr;
+    if (video) {
+      const long frames = video->finish(args.video);
+      j["video"] = {{"path", args.video}, {"frames", frames}, {"fps", 30}};
+    }
+  }
   if (!args.out.empty()) write_file_atomic(args.out, j.dump(2) + "\n");
   if (args.json)
     std::cout << j.dump(2) << "\n";
   else
     print_report(scene, report, options);
+  if (j.contains("video") && !j["video"].is_null())
+    std::cout << "wrote " << args.video << ": " << j["video"]["frames"].get<long>() << " frames at 30 fps ("
+              << size->first << "x" << size->second << " pixels)\n";
   return report.first_contact || report.left_bounds ? kExitFindings : kExitOk;
 }
 

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "json_io.hpp"
+#include "leeway/bounds_trajectory.hpp"
 #include "leeway/cell_defaults.hpp"
 #include "leeway/check.hpp"
 #include "leeway/confidence.hpp"
@@ -21,6 +22,7 @@
 #include "leeway/path_check.hpp"
 #include "leeway/pipeline.hpp"
 #include "leeway/planner.hpp"
+#include "leeway/simulate.hpp"
 #include "leeway/tuning.hpp"
 #include "mjcf_text.hpp"
 
@@ -35,10 +37,10 @@ const char* const kSuiteFormat = "leeway-suite-1";
 const char* const kResultsFormat = "leeway-batch-results-1";
 
 // The keys a scenario (and the suite's defaults) may hold; docs/batch.md.
-const std::set<std::string> kScenarioKeys = {"name",      "cell",    "from",   "to",     "path",
-                                             "waypoints", "ik_seed", "preset", "params", "max_cells",
-                                             "safety",    "checker", "cf",     "plan",   "expect"};
-const std::set<std::string> kNestedKeys = {"cf", "plan", "expect"};
+const std::set<std::string> kScenarioKeys = {
+    "name",   "cell",      "from",   "to",      "path", "waypoints", "ik_seed", "preset",
+    "params", "max_cells", "safety", "checker", "cf",   "plan",      "expect",  "simulate"};
+const std::set<std::string> kNestedKeys = {"cf", "plan", "expect", "simulate"};
 
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
@@ -148,9 +150,28 @@ void check_fields(const Fields& f, const json& s, bool is_defaults) {
     f.whole("plan.seed", 0, std::numeric_limits<long long>::max());
     f.number("plan.time_limit", 1e-3, 3600, "a time from 0.001 to 3600 s");
   }
+  if (s.contains("simulate")) {
+    f.known_keys(s["simulate"], "simulate",
+                 {"human", "target", "amplitude", "bandwidth", "seed", "speed", "controller"});
+    f.one_of("simulate.human", {"random", "push-toward", "none"});
+    f.text("simulate.target");
+    f.number("simulate.amplitude", 0, 2000, "a force from 0 to 2000 N");
+    f.number("simulate.bandwidth", 1e-6, 20, "a frequency from 0 (excluded) to 20 Hz");
+    f.whole("simulate.seed", 0, std::numeric_limits<long long>::max());
+    f.number("simulate.speed", 1e-6, 10, "a share of the nominal speed from 0 (excluded) to 10");
+    f.one_of("simulate.controller", {"mpc", "projection"});
+    if (s["simulate"].value("human", std::string()) == "push-toward" && !s["simulate"].contains("target"))
+      f.fail("simulate.target", "is missing: push-toward needs an obstacle's name or \"nearest\"");
+  }
   if (s.contains("expect")) {
-    f.known_keys(s["expect"], "expect",
-                 {"check", "cf_min", "certified", "mean_width_min", "self_collisions_max", "time_max"});
+    f.known_keys(
+        s["expect"], "expect",
+        {"check", "cf_min", "certified", "mean_width_min", "self_collisions_max", "time_max", "simulate"});
+    if (s["expect"].contains("simulate")) {
+      f.known_keys(s["expect"]["simulate"], "expect.simulate", {"contacts", "min_distance"});
+      f.whole("expect.simulate.contacts", 0, std::numeric_limits<long long>::max());
+      f.number("expect.simulate.min_distance", 0, 100, "a distance from 0 to 100 m");
+    }
     f.whole("expect.self_collisions_max", 0, std::numeric_limits<long long>::max());
     f.flag("expect.check");
     f.number("expect.cf_min", 0, 1, "a fraction from 0 to 1");
@@ -324,6 +345,9 @@ Suite read_suite(const std::string& file) {
     if (s.contains("expect") && s["expect"].contains("self_collisions_max"))
       sc.expect.self_collisions_max = s["expect"]["self_collisions_max"].get<long>();
     sc.expect.time_max = f.number("expect.time_max", 0, 1e6, "");
+    if (const auto c = f.whole("expect.simulate.contacts", 0, std::numeric_limits<long long>::max()))
+      sc.expect.simulate_contacts_max = static_cast<long>(*c);
+    sc.expect.simulate_min_distance = f.number("expect.simulate.min_distance", 0, 100, "");
     suite.scenarios.push_back(std::move(sc));
   }
   return suite;
@@ -427,6 +451,38 @@ json run_scenario(const json& resolved, int threads) {
     measured["mean_width"] = widths.mean_width;
     measured["bisected"] = widths.bisected;
     measured["collapsed"] = widths.collapsed;
+    // The closed loop (docs/simulate.md), when the scenario asks for it or expects its outcome.
+    if (s.contains("simulate") || (s.contains("expect") && s["expect"].contains("simulate"))) {
+      const json sim = s.value("simulate", json::object());
+      SimulateOptions so;
+      const std::string human = sim.value("human", std::string("random"));
+      so.human.kind = human == "none"          ? HumanKind::kNone
+                      : human == "push-toward" ? HumanKind::kPushToward
+                                               : HumanKind::kRandom;
+      so.human.target = sim.value("target", std::string());
+      so.human.amplitude = sim.value("amplitude", so.human.amplitude);
+      so.human.bandwidth = sim.value("bandwidth", so.human.bandwidth);
+      so.seed = sim.value("seed", so.seed);
+      so.speed = sim.value("speed", so.speed);
+      so.controller = sim.value("controller", std::string("mpc")) == "projection"
+                          ? ControllerKind::kProjection
+                          : ControllerKind::kMpc;
+      const auto s0 = Clock::now();
+      const SimulationReport sr = simulate(scene, BoundsTrajectory(scene, run.bounds), so);
+      timing["simulate_s"] = seconds_since(s0);
+      measured["simulate_contacts"] = sr.contact_steps;
+      measured["simulate_min_distance"] = sr.min_distance;
+      measured["simulate_left_bounds"] = sr.left_bounds;
+      measured["simulate_reached_end"] = sr.reached_end;
+      json freedom = json::array();
+      for (Eigen::Index j = 0; j < sr.freedom_used.size(); ++j) freedom.push_back(sr.freedom_used[j]);
+      measured["simulate_freedom_used"] = freedom;
+      if (sr.first_contact)
+        measured["simulate_first_contact"] = {{"t", sr.first_contact->t},
+                                              {"geom1", sr.first_contact->geom1},
+                                              {"geom2", sr.first_contact->geom2},
+                                              {"depth", sr.first_contact->depth}};
+    }
     r["status"] = "ok";
     r["measured"] = measured;
     timing["method_s"] = run.ms_total() / 1000;
@@ -477,6 +533,13 @@ void judge(const Scenario& scenario, json& result) {
   if (x.self_collisions_max)
     add("self_collisions_max", "CF samples in self-collision <= " + std::to_string(*x.self_collisions_max),
         *x.self_collisions_max, "cf_self_collisions", -1);
+  if (x.simulate_contacts_max)
+    add("simulate_contacts", "simulated steps with a contact <= " + std::to_string(*x.simulate_contacts_max),
+        *x.simulate_contacts_max, "simulate_contacts", -1);
+  if (x.simulate_min_distance)
+    add("simulate_min_distance",
+        "simulated min distance >= " + format_number(*x.simulate_min_distance) + " m",
+        *x.simulate_min_distance, "simulate_min_distance", 1);
   result["expectations"] = list;
   result["passed"] = all;
   if (x.time_max) {

@@ -268,6 +268,37 @@ TEST_F(BatchTest, ASuiteWhoseExpectationsAllHoldExitsZero) {
   EXPECT_THAT(r.out, HasSubstr("1 passed, 0 failed, 0 errors"));
 }
 
+// The closed loop in a suite: a co-worker pushing the one-link arm toward the table inside its
+// certified bounds makes no contact; an expectation of 50 m of clearance fails with the measured
+// distance.
+TEST_F(BatchTest, SimulateExpectationsJudgeTheClosedLoop) {
+  const json push = {{"human", "push-toward"}, {"target", "table"}, {"amplitude", 80}};
+  const json scenarios = {{{"name", "held"},
+                           {"from", "a"},
+                           {"to", "b"},
+                           {"simulate", push},
+                           {"expect", {{"simulate", {{"contacts", 0}, {"min_distance", 0.0005}}}}}},
+                          {{"name", "far"},
+                           {"from", "a"},
+                           {"to", "b"},
+                           {"simulate", push},
+                           {"expect", {{"simulate", {{"min_distance", 50}}}}}}};
+  const auto r =
+      test::run_cli("batch " + suite(scenarios) + " --out " + path("results.json") + " --threads 1");
+  ASSERT_EQ(r.exit_code, 1) << r.out;
+  const json results = test::read_json(path("results.json"));
+  const json& held = results["scenarios"][0];
+  EXPECT_EQ(held["passed"], true) << held.dump(1);
+  EXPECT_EQ(held["measured"]["simulate_contacts"], 0);
+  EXPECT_EQ(held["measured"]["simulate_left_bounds"], false);
+  EXPECT_GE(held["measured"]["simulate_min_distance"].get<double>(), 0.0005);
+  EXPECT_LT(held["measured"]["simulate_min_distance"].get<double>(), 0.5);  // it was pushed close
+  const json& far = results["scenarios"][1];
+  EXPECT_EQ(far["passed"], false);
+  EXPECT_EQ(far["expectations"][0]["title"], "simulated min distance >= 50 m");
+  EXPECT_EQ(far["expectations"][0]["measured"], held["measured"]["simulate_min_distance"]);
+}
+
 TEST_F(BatchTest, ABadSuiteIsExitTwoBeforeAnyScenarioRunsAndWritesNothing) {
   json second = {{"name", "second"}, {"from", "a"}, {"to", "b"}};
   const auto with = [&](const std::string& key, const json& value) {
@@ -290,6 +321,13 @@ TEST_F(BatchTest, ABadSuiteIsExitTwoBeforeAnyScenarioRunsAndWritesNothing) {
       {{passing(), with("path", "missing.json")}, "field 'path' excludes 'from' and 'to'"},
       {{passing(), with("params", {{"volume", {{"h_max", -1}}}})}, "scenario 2 'second': field 'params': "},
       {{passing(), with("params", 7)}, "field 'params' must be a parameter file's name or an object"},
+      {{passing(), with("simulate", {{"human", "shove"}})}, "field 'simulate.human' 'shove' must be one of"},
+      {{passing(), with("simulate", {{"human", "push-toward"}})}, "field 'simulate.target' is missing"},
+      {{passing(), with("simulate", {{"amplitude", 1e6}})}, "field 'simulate.amplitude' 1000000.0 must be"},
+      {{passing(), with("expect", {{"simulate", {{"contacts", -1}}}})},
+       "field 'expect.simulate.contacts' -1 must be a whole number"},
+      {{passing(), with("expect", {{"simulate", {{"touches", 0}}}})},
+       "field 'expect.simulate.touches' is not a known key"},
   };
   for (const auto& [scenarios, message] : bad) {
     const auto r =

@@ -13,12 +13,14 @@ namespace leeway {
 
 //! What a scenario must achieve; absent expectations are not tested.
 struct Expectations {
-  std::optional<bool> check;                //!< `leeway check` of the cell passes (true) or not (false)
-  std::optional<double> cf_min;             //!< Confidence Factor >= this (fraction, 0..1)
-  std::optional<bool> certified;            //!< the safety stage certified every segment (or not)
-  std::optional<double> mean_width_min;     //!< mean width of the bisected intervals >= this [rad]
-  std::optional<long> self_collisions_max;  //!< CF samples where the robot hits itself <= this
-  std::optional<double> time_max;           //!< the method's time <= this [s]; a soft warning only
+  std::optional<bool> check;                    //!< `leeway check` of the cell passes (true) or not (false)
+  std::optional<double> cf_min;                 //!< Confidence Factor >= this (fraction, 0..1)
+  std::optional<bool> certified;                //!< the safety stage certified every segment (or not)
+  std::optional<double> mean_width_min;         //!< mean width of the bisected intervals >= this [rad]
+  std::optional<long> self_collisions_max;      //!< CF samples where the robot hits itself <= this
+  std::optional<double> time_max;               //!< the method's time <= this [s]; a soft warning only
+  std::optional<long> simulate_contacts_max;    //!< closed-loop steps with a contact <= this
+  std::optional<double> simulate_min_distance;  //!< closed-loop smallest distance >= this [m]
 };
 
 //! One scenario of a suite, validated.

@@ -8,6 +8,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -300,6 +302,78 @@ TEST_F(SimulateTest, FilePushIsInterpolatedAndFollowed) {
              [&](const mjModel& m, const mjData& d, const SimFrame&) { last_q = d.qpos[m.jnt_qposadr[0]]; });
     EXPECT_GT(sign * last_q, 0.05) << sign;
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The command line
+
+const std::string kDallaraBounds = std::string(LEEWAY_TEST_DATA_DIR) + "/cli_golden/dallara_bounds.json";
+
+TEST(CliSimulate, WritesTheReportAndExitsZeroWithoutContact) {
+  test::TempDir dir;
+  const std::string out = (dir.path() / "r.json").string();
+  const auto r = test::run_cli("simulate " + test::workcell("dallara") + " --bounds " + kDallaraBounds +
+                               " --human push-toward nearest --out " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_THAT(r.out, HasSubstr("contacts: 0 (min distance "));
+  EXPECT_THAT(r.out, HasSubstr("bounds: never left"));
+  const nlohmann::json j = test::read_json(out);
+  EXPECT_EQ(j.at("format"), "leeway-simulation-1");
+  EXPECT_EQ(j.at("contacts"), 0);
+  EXPECT_TRUE(j.at("first_contact").is_null());
+  EXPECT_EQ(j.at("left_bounds"), false);
+  EXPECT_EQ(j.at("human").at("kind"), "push-toward");
+  EXPECT_EQ(j.at("joints").size(), 6u);
+  EXPECT_EQ(j.at("freedom_used").size(), 6u);
+  EXPECT_EQ(j.at("reached_end"), true);
+}
+
+// A contact is a finding: exit 1, and the report says where.
+TEST(CliSimulate, AContactIsExitOne) {
+  test::TempDir dir;
+  const std::string cell = dir.write("cell.xml", test::one_link_cell(kWall, R"(<key name="a" qpos="0"/>)"));
+  // Bounds past the wall, written by hand in the bounds file's format 1 (the cell's joint speed
+  // times it).
+  const std::string bounds = dir.write("b.json", R"({"format": "leeway-bounds-1", "joints": ["j1"],
+    "waypoints": [{"q": [0], "lower": [-0.4], "upper": [0.6]}, {"q": [0], "lower": [-0.4], "upper": [0.6]}]})");
+  const auto r =
+      test::run_cli("simulate " + cell + " --bounds " + bounds + " --human push-toward wall --json");
+  ASSERT_EQ(r.exit_code, 1) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("first_contact").at("geom1"), "link_box");
+  EXPECT_EQ(j.at("first_contact").at("geom2"), "wall");
+}
+
+// Without ffmpeg on PATH, --video is a warning: the run goes on and its report is written.
+TEST(CliSimulate, WithoutFfmpegTheRunGoesOnWithoutAVideo) {
+  test::TempDir dir;
+  const std::string video = (dir.path() / "run.mp4").string(), out = (dir.path() / "r.json").string();
+  const auto r = test::run_program("env PATH=" + dir.path().string() + " " + std::string(LEEWAY_CLI),
+                                   "simulate " + test::workcell("dallara") + " --bounds " + kDallaraBounds +
+                                       " --human none --video " + video + " --out " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_THAT(r.out, HasSubstr("ffmpeg is not on PATH"));
+  EXPECT_FALSE(std::filesystem::exists(video));
+  EXPECT_TRUE(test::read_json(out).at("video").is_null());
+}
+
+// With ffmpeg: an MP4 (its first box is 'ftyp') of 30 frames per simulated second.
+TEST(CliSimulate, VideoIsAnMp4AtThirtyFramesPerSecond) {
+  if (std::system("command -v ffmpeg > /dev/null 2>&1") != 0) GTEST_SKIP() << "ffmpeg is not installed";
+  test::TempDir dir;
+  const std::string video = (dir.path() / "run.mp4").string(), out = (dir.path() / "r.json").string();
+  const auto r = test::run_cli("simulate " + test::workcell("dallara") + " --bounds " + kDallaraBounds +
+                               " --human random --video " + video + " --size 160x120 --out " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const std::string bytes = test::read_text(video);
+  ASSERT_GT(bytes.size(), 1000u);
+  EXPECT_EQ(bytes.substr(4, 4), "ftyp");
+  const nlohmann::json j = test::read_json(out);
+  const double seconds = j.at("simulated_time").get<double>();
+  EXPECT_NEAR(j.at("video").at("frames").get<double>(), 30 * seconds, 2);
+  for (const auto& e : std::filesystem::directory_iterator(dir.path()))
+    EXPECT_EQ(e.path().filename().string().rfind(".run.mp4", 0), std::string::npos)
+        << "temporary left behind";
 }
 
 }  // namespace

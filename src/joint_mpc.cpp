@@ -1,5 +1,7 @@
 #include "leeway/joint_mpc.hpp"
 
+#include <Eigen/Cholesky>
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -62,7 +64,7 @@ JointMpc::JointMpc(const JointMpcOptions& options) : options_(options) {
   rho_ = 1;
   sigma_ = 1e-6;
   Eigen::MatrixXd kkt = p + sigma_ * Eigen::MatrixXd::Identity(n, n) + rho_ * a_.transpose() * a_;
-  kkt_.compute(kkt);
+  kkt_inverse_ = kkt.llt().solve(Eigen::MatrixXd::Identity(n, n));
   reset();
 }
 
@@ -102,7 +104,7 @@ JointPlan JointMpc::solve(double q0, double v0, const Eigen::VectorXd& reference
   for (int it = 0; it < options_.iterations; ++it) {
     rhs.noalias() = sigma_ * x - q_lin;
     rhs.noalias() += a_.transpose() * (rho_ * z - y);
-    x_tilde = kkt_.solve(rhs);
+    x_tilde.noalias() = kkt_inverse_ * rhs;
     z_tilde.noalias() = a_ * x_tilde;
     x = kAlpha * x_tilde + (1 - kAlpha) * x;
     z_relaxed = kAlpha * z_tilde + (1 - kAlpha) * z;

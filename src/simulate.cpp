@@ -119,12 +119,6 @@ std::vector<int> target_geoms(const Scene& scene, const std::string& target) {
   return out;
 }
 
-// The distance between two geoms from their boxes (geom_box): exact for two boxes, a lower bound
-// when either is another type.
-double box_gap(const mjModel& m, const mjData& d, int g1, int g2) {
-  return box_distance(geom_box(m, d, g1), geom_box(m, d, g2));
-}
-
 // The human: a wrench at the tool site for the current state.
 class Human {
  public:
@@ -355,6 +349,30 @@ SimulationReport simulate(const Scene& scene, const BoundsTrajectory& bounds, co
   std::vector<mjtNum> jacp(3 * m.nv), jacr(3 * m.nv), acc(m.nv), mass_acc(m.nv);
   Eigen::VectorXd human_gen(m.nv);
   const std::vector<RobotPair>& self_pairs = scene.self_pairs();
+  // The boxes of the distance measurement: the cell's are fixed (taken once), the robot's are taken
+  // at every step for the geoms that move or pair with one.
+  std::vector<Box> boxes(static_cast<size_t>(m.ngeom));
+  std::vector<Aabb> box_bounds(static_cast<size_t>(m.ngeom));
+  std::vector<int> robot_geoms = scene.link_geoms();
+  for (const RobotPair& p : self_pairs)
+    for (int g : {p.geom1, p.geom2})
+      if (std::find(robot_geoms.begin(), robot_geoms.end(), g) == robot_geoms.end()) robot_geoms.push_back(g);
+  const auto take_box = [&](int g) {
+    const Box b = geom_box(m, d, g);
+    const Eigen::Vector3d extent = b.rotation.cwiseAbs() * b.half_size;
+    boxes[static_cast<size_t>(g)] = b;
+    box_bounds[static_cast<size_t>(g)] = {b.center - extent, b.center + extent};
+  };
+  mj_kinematics(&m, &d);
+  for (int o : scene.obstacle_geoms())
+    if (has_bounding_box(m, o)) take_box(o);
+  // A lower bound of the distance between two geoms' boxes: the gap between their bounding boxes.
+  const auto bound_gap = [&](int g1, int g2) {
+    const Aabb& a = box_bounds[static_cast<size_t>(g1)];
+    const Aabb& b = box_bounds[static_cast<size_t>(g2)];
+    const Eigen::Vector3d gap = (a.lo - b.hi).cwiseMax(b.lo - a.hi).cwiseMax(0.0);
+    return gap.norm();
+  };
 
   // Stage ends of the MPC's horizon [s after now].
   const JointMpcOptions& mo = options.mpc;
@@ -442,7 +460,7 @@ SimulationReport simulate(const Scene& scene, const BoundsTrajectory& bounds, co
         double a = 0;
         if (options.controller == ControllerKind::kMpc) {
           for (int k = 0; k < mo.horizon; ++k) {
-            const double margin = std::min(options.plan_margin, 0.5 * (stage_hi[k][j] - stage_lo[k][j]));
+            const double margin = std::min(options.plan_margin, 0.25 * (stage_hi[k][j] - stage_lo[k][j]));
             lower[k] = stage_lo[k][j] + margin;
             upper[k] = stage_hi[k][j] - margin;
             ref[k] = std::clamp(stage_nom[k][j] + dev[j] + dev_rate[j] * stage_end[k], lower[k], upper[k]);
@@ -452,7 +470,7 @@ SimulationReport simulate(const Scene& scene, const BoundsTrajectory& bounds, co
           // The baseline: the admitted target clamped into the next box, reached as fast as the
           // limits allow.
           const int k = 0;
-          const double margin = std::min(options.plan_margin, 0.5 * (stage_hi[k][j] - stage_lo[k][j]));
+          const double margin = std::min(options.plan_margin, 0.25 * (stage_hi[k][j] - stage_lo[k][j]));
           const double low = stage_lo[k][j] + margin, high = stage_hi[k][j] - margin;
           const double goal = std::clamp(stage_nom[k][j] + dev[j], low, high);
           // No faster toward a bound than can stop at it: v^2 <= 2 a_max d, in discrete time.
@@ -466,13 +484,75 @@ SimulationReport simulate(const Scene& scene, const BoundsTrajectory& bounds, co
         }
         ac[j] = a;
       }
-      // Progress: as far toward the wished s as keeps the command, where it will be at the period's
-      // end, inside the box (the command never waits for the path; the path waits for the command).
+      // The safety filter: each joint's acceleration is the one nearest the controller's that keeps
+      // the command inside the box at the current s with room to stop there (its stopping point at
+      // full deceleration inside the box), within the speed and acceleration limits. So the command
+      // can always stay inside the box, whatever the path's progress does next.
+      bool stop_inside_now = true;
+      for (int j = 0; j < n; ++j) {
+        const double margin = std::min(options.plan_margin, 0.25 * (hi[j] - lo[j]));
+        const double low = lo[j] + margin, high = hi[j] - margin;
+        const double a_min = std::max(-options.max_accel, (-vmax[j] - vc[j]) / hc);
+        const double a_max = std::min(options.max_accel, (vmax[j] - vc[j]) / hc);
+        const auto end_of = [&](double a, double& q1, double& stop) {
+          q1 = qc[j] + hc * vc[j] + 0.5 * hc * hc * a;
+          const double v1 = vc[j] + hc * a;
+          stop = q1 + v1 * std::abs(v1) / (2 * options.max_accel);
+        };
+        // Both the end and the stopping point grow with a: bisect for the interval of a that keeps
+        // both within [low, high].
+        const auto first_at_least = [&](double bound) {  // smallest a with end and stop >= bound
+          double q1 = 0, stop = 0;
+          end_of(a_min, q1, stop);
+          if (std::min(q1, stop) >= bound) return a_min;
+          end_of(a_max, q1, stop);
+          if (std::min(q1, stop) < bound) return kInf;
+          double lo_a = a_min, hi_a = a_max;
+          for (int it = 0; it < 50; ++it) {
+            const double mid = 0.5 * (lo_a + hi_a);
+            end_of(mid, q1, stop);
+            (std::min(q1, stop) >= bound ? hi_a : lo_a) = mid;
+          }
+          return hi_a;
+        };
+        const auto last_at_most = [&](double bound) {  // largest a with end and stop <= bound
+          double q1 = 0, stop = 0;
+          end_of(a_max, q1, stop);
+          if (std::max(q1, stop) <= bound) return a_max;
+          end_of(a_min, q1, stop);
+          if (std::max(q1, stop) > bound) return -kInf;
+          double lo_a = a_min, hi_a = a_max;
+          for (int it = 0; it < 50; ++it) {
+            const double mid = 0.5 * (lo_a + hi_a);
+            end_of(mid, q1, stop);
+            (std::max(q1, stop) <= bound ? lo_a : hi_a) = mid;
+          }
+          return lo_a;
+        };
+        const double from = first_at_least(low), to = last_at_most(high);
+        if (from <= to) {
+          ac[j] = std::clamp(ac[j], from, to);
+        } else {
+          // No acceleration can (the box is narrower than the motion needs, e.g. a bound of zero
+          // width on a moving path): brake toward the box; the clamp below keeps the command in it.
+          double q1 = 0, stop = 0;
+          end_of(0, q1, stop);
+          ac[j] = stop > high ? a_min : a_max;
+          stop_inside_now = false;
+        }
+      }
+      // Progress: as far toward the wished s as keeps the command where it will be at the period's
+      // end, and its stopping point, inside the box (the path waits for the command).
       const Eigen::VectorXd q_end = qc + hc * vc + 0.5 * hc * hc * ac;
+      const Eigen::VectorXd v_end = vc + hc * ac;
       const auto inside = [&](double s_next) {
         bounds.at_s(s_next, n_k, lo_k, hi_k);
-        for (int j = 0; j < n; ++j)
+        for (int j = 0; j < n; ++j) {
+          const double margin = std::min(options.plan_margin, 0.25 * (hi_k[j] - lo_k[j]));
+          const double stop = q_end[j] + v_end[j] * std::abs(v_end[j]) / (2 * options.max_accel);
           if (q_end[j] < lo_k[j] || q_end[j] > hi_k[j]) return false;
+          if (stop_inside_now && (stop < lo_k[j] + margin || stop > hi_k[j] - margin)) return false;
+        }
         return true;
       };
       double reached = target;
@@ -488,11 +568,12 @@ SimulationReport simulate(const Scene& scene, const BoundsTrajectory& bounds, co
       s_to = reached;
       rate_prev = (s_to - s_from) / hc;
 
-      bool over = false;
+      double ratio = 0;
       for (int j = 0; j < n; ++j)
-        over = over || std::abs(ac[j]) > options.max_accel * (1 + 1e-6) ||
-               std::abs(vc[j] + hc * ac[j]) > vmax[j] * (1 + 1e-6);
-      if (over) ++report.limit_steps;
+        ratio =
+            std::max({ratio, std::abs(ac[j]) / options.max_accel, std::abs(vc[j] + hc * ac[j]) / vmax[j]});
+      if (ratio > 1 + 1e-6) ++report.limit_steps;
+      report.max_limit_ratio = std::max(report.max_limit_ratio, ratio);
 
       if (on_frame) {
         SimFrame frame;
@@ -580,22 +661,32 @@ SimulationReport simulate(const Scene& scene, const BoundsTrajectory& bounds, co
         touch(first_is_link ? con.geom1 : con.geom2, first_is_link ? con.geom2 : con.geom1,
               std::max(0.0, -static_cast<double>(con.dist)), false);
       }
+      // Only pairs that may come nearer than the smallest distance so far are measured: the run's
+      // minimum is exact, and most pairs are left out after the first steps.
+      const auto reach = [&] {
+        return report.min_distance_capped ? options.distance_range : report.min_distance;
+      };
+      for (int g : robot_geoms) take_box(g);
       for (const RobotPair& p : self_pairs) {
         if (geoms_touch(m, d, p.geom1, p.geom2)) {
-          touch(p.geom1, p.geom2, box_penetration(geom_box(m, d, p.geom1), geom_box(m, d, p.geom2)), true);
-        } else {
-          near(p.geom1, p.geom2, box_gap(m, d, p.geom1, p.geom2));
+          touch(p.geom1, p.geom2,
+                box_penetration(boxes[static_cast<size_t>(p.geom1)], boxes[static_cast<size_t>(p.geom2)]),
+                true);
+        } else if (bound_gap(p.geom1, p.geom2) <= reach()) {
+          near(p.geom1, p.geom2,
+               box_distance(boxes[static_cast<size_t>(p.geom1)], boxes[static_cast<size_t>(p.geom2)]));
         }
       }
-      // Distances to the cell: every obstacle whose box comes within the range of a link's box.
+      // Distances to the cell: the obstacles whose boxes' bounds come within reach of a link's.
       const StaticGeoms& statics = scene.statics();
       for (int l : scene.link_geoms()) {
-        Aabb query = geom_aabb(m, d, l);
-        query.lo.array() -= options.distance_range;
-        query.hi.array() += options.distance_range;
+        Aabb query = box_bounds[static_cast<size_t>(l)];
+        query.lo.array() -= reach();
+        query.hi.array() += reach();
         statics.grid.any(query, [&](int i) {
           const int o = statics.geoms[static_cast<size_t>(i)];
-          if (scene.role(o) == GeomRole::kObstacle && has_bounding_box(m, o)) near(l, o, box_gap(m, d, l, o));
+          if (scene.role(o) == GeomRole::kObstacle && has_bounding_box(m, o) && bound_gap(l, o) <= reach())
+            near(l, o, box_distance(boxes[static_cast<size_t>(l)], boxes[static_cast<size_t>(o)]));
           return false;
         });
       }
@@ -715,6 +806,7 @@ nlohmann::json simulation_json(const Scene& scene, const SimulationReport& r, co
           {"max_excursion", r.max_excursion},
           {"clamp_steps", r.clamp_steps},
           {"limit_periods", r.limit_steps},
+          {"max_limit_ratio", r.max_limit_ratio},
           {"freedom_used", vec(r.freedom_used)},
           {"max_deviation", vec(r.max_deviation)},
           {"max_tracking_error", r.max_tracking_error},

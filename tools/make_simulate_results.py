@@ -232,8 +232,9 @@ def render(info, results):
     for k in keys:
         runs = [x for x in ok(results[k]["default"].get("runs", [])) if x["left_bounds"]]
         if runs:
-            outside.append(f"{k.replace('/', ' ')} ({len(runs)} runs, max excursion "
-                           f"{max(x['max_excursion'] for x in runs):.4f} rad or m)")
+            worst = max(x["max_excursion"] for x in runs)
+            outside.append(f"{k.replace('/', ' ')} ({len(runs)} run{'s' if len(runs) > 1 else ''}, max excursion "
+                           + (f"{worst:.4f}" if worst >= 1e-4 else f"{worst:.1e}") + " rad or m)")
     if outside:
         line += "; left the bounds on " + ", ".join(outside)
     o.append(line + ".")

@@ -8,10 +8,9 @@
 //! problems of this size (docs/simulate.md, "Controller").
 //!
 //! Each problem is a small dense QP, solved by ADMM (the operator splitting of OSQP) with a
-//! factorisation made once per horizon and a fixed iteration count: no allocation per solve, the
+//! matrix inverted once per horizon and a fixed iteration count: no allocation per solve, the
 //! same work every period, and the same answer for the same input.
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
 
 namespace leeway {
@@ -66,8 +65,8 @@ class JointMpc {
   Eigen::MatrixXd phi_v_;      // v_k - v0 = (phi_v_ x)_k
   Eigen::MatrixXd a_;          // constraint rows [phi_q; phi_v; I], each scaled to unit norm
   Eigen::VectorXd row_scale_;
-  Eigen::LLT<Eigen::MatrixXd> kkt_;  // P + sigma I + rho A^T A
-  double cost_scale_ = 1;            // P's largest diagonal value before scaling
+  Eigen::MatrixXd kkt_inverse_;  // (P + sigma I + rho A^T A)^-1: small, so one product per iteration
+  double cost_scale_ = 1;        // P's largest diagonal value before scaling
   double rho_ = 0, sigma_ = 0;
   // Warm start (x: accelerations, z and y: constraint values and multipliers).
   Eigen::VectorXd x_, z_, y_;

@@ -84,7 +84,7 @@ struct SimulateOptions {
   //! The push against the tool's direction of travel that stops progress along the path [N];
   //! progress slows linearly from no push to this one.
   double hold_force = 80;
-  //! How far inside the bounds the controller plans [rad or m] (at most half a bound's width).
+  //! How far inside the bounds the controller plans [rad or m] (at most a quarter of a bound's width).
   double plan_margin = 1e-3;
   //! Low-level joint servo: the bandwidth of a computed-torque PD loop [Hz], critically damped.
   double servo_bandwidth = 10;
@@ -137,6 +137,9 @@ struct SimulationReport {
   double max_excursion = 0;  //!< the most it was [rad or m] (0 when it never was)
   long clamp_steps = 0;      //!< steps where the safety clamp moved the command into the box
   long limit_steps = 0;      //!< control periods whose command broke the speed or acceleration limit
+  //! The largest |a| / a_max or |v| / v_max of the command over the control periods (over 1: a
+  //! limit was broken, by that factor).
+  double max_limit_ratio = 0;
   //! Per joint: the largest share of the room between nominal and bound (on the side it moved to)
   //! that the robot used, in [0, 1].
   Eigen::VectorXd freedom_used;

@@ -227,7 +227,8 @@ void print_report(const Scene& scene, const SimulationReport& r, const SimulateO
   }
   out << "bounds: " << (r.left_bounds ? "LEFT (max excursion " : "never left (max excursion ")
       << r.max_excursion << " rad or m); safety clamp on " << r.clamp_steps << " steps; limits exceeded in "
-      << r.limit_steps << " control periods; max tracking error " << r.max_tracking_error << " rad or m\n";
+      << r.limit_steps << " control periods (by up to x" << r.max_limit_ratio << "); max tracking error "
+      << r.max_tracking_error << " rad or m\n";
   out << "freedom used [share of the room to the bound, per joint]:";
   for (Eigen::Index j = 0; j < r.freedom_used.size(); ++j)
     out << " " << scene.joint_names()[j] << " " << r.freedom_used[j];

@@ -154,7 +154,9 @@ class VideoWriter {
           radius, (Eigen::Vector2d(d->site_xpos[3 * site], d->site_xpos[3 * site + 1]) - base).norm() + 1);
     }
     const double fovy = scene.model().vis.global.fovy * 3.14159265358979323846 / 180;
-    renderer_ = std::make_unique<FrameRenderer>(scene, width, height, frame_circle(base, radius, 2.5, fovy));
+    RenderCamera camera = frame_circle(base, radius, 2.5, fovy);
+    camera.elevation = -0.45;  // lower than a still picture's: the push is mostly level or down
+    renderer_ = std::make_unique<FrameRenderer>(scene, width, height, camera);
     const std::string command =
         shell_quote(ffmpeg) + " -hide_banner -loglevel error -y -f rawvideo -pix_fmt rgb24 -s " +
         std::to_string(width) + "x" + std::to_string(height) +

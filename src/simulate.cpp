@@ -244,488 +244,595 @@ void SimulateOptions::check() const {
   require_range(max_accel, 0, 1e4, "max acceleration", "rad/s^2", true);
   require_range(hold_force, 0, 1e4, "hold force", "N", true);
   require_range(plan_margin, 0, 0.1, "plan margin", "rad");
-  require_range(servo_bandwidth, 0, 1000, "servo bandwidth", "Hz", true);
   require_range(distance_range, 0, 10, "distance range", "m", true);
   require_range(end_hold, 0, 3600, "end hold", "s");
   require_range(max_time, 0, 36000, "max time", "s");
 }
 
-SimulationReport simulate(const Scene& scene, const BoundsTrajectory& bounds, const SimulateOptions& options,
-                          const FrameCallback& on_frame) {
-  options.check();
-  const auto wall_start = std::chrono::steady_clock::now();
-  const int n = scene.dof();
-  if (bounds.dof() != n)
+namespace {
+
+// One joint's acceleration interval that keeps, after a period of length h from (q, v) at constant
+// acceleration, both the position and the stopping point (where braking at a_max would bring it to
+// rest) within [low, high], with |a| <= a_max and |v'| <= v_max. Both grow with a, so each end of the
+// interval is found by bisection. Empty (from > to) when no acceleration can.
+struct AccelInterval {
+  double from = 0, to = 0;
+  double a_min = 0, a_max = 0;  // the limits' interval
+};
+
+AccelInterval stay_and_stop_within(double q, double v, double h, double low, double high, double v_max,
+                                   double a_max) {
+  AccelInterval r;
+  r.a_min = std::max(-a_max, (-v_max - v) / h);
+  r.a_max = std::min(a_max, (v_max - v) / h);
+  const auto end_and_stop = [&](double a) {
+    const double q1 = q + h * v + 0.5 * h * h * a;
+    const double v1 = v + h * a;
+    return std::pair<double, double>{q1, q1 + v1 * std::abs(v1) / (2 * a_max)};
+  };
+  const auto lowest = [&](double a) {
+    const auto [q1, stop] = end_and_stop(a);
+    return std::min(q1, stop);
+  };
+  const auto highest = [&](double a) {
+    const auto [q1, stop] = end_and_stop(a);
+    return std::max(q1, stop);
+  };
+  // The smallest a with both >= low.
+  if (lowest(r.a_min) >= low) {
+    r.from = r.a_min;
+  } else if (lowest(r.a_max) < low) {
+    r.from = kInf;
+  } else {
+    double bad = r.a_min, ok = r.a_max;
+    for (int it = 0; it < 50; ++it) {
+      const double mid = 0.5 * (bad + ok);
+      (lowest(mid) >= low ? ok : bad) = mid;
+    }
+    r.from = ok;
+  }
+  // The largest a with both <= high.
+  if (highest(r.a_max) <= high) {
+    r.to = r.a_max;
+  } else if (highest(r.a_min) > high) {
+    r.to = -kInf;
+  } else {
+    double ok = r.a_min, bad = r.a_max;
+    for (int it = 0; it < 50; ++it) {
+      const double mid = 0.5 * (ok + bad);
+      (highest(mid) <= high ? ok : bad) = mid;
+    }
+    r.to = ok;
+  }
+  return r;
+}
+
+// The closed loop's state and its steps; simulate() runs it. The physics step (mj_step1, then the
+// controller, the measurements and the servo, then mj_step2) is step(); a control period's work
+// (the push, the admittance, the progress and the plan) is start_period().
+class ClosedLoop {
+ public:
+  ClosedLoop(const Scene& scene, const BoundsTrajectory& bounds, const SimulateOptions& options);
+  SimulationReport run(const FrameCallback& on_frame);
+
+ private:
+  double margin(double low, double high) const { return std::min(options_.plan_margin, 0.25 * (high - low)); }
+  Eigen::Vector3d tool_at(const Eigen::VectorXd& q);
+  void push_on_joints();
+  void start_period(double t, const Eigen::Vector3d& tool);
+  double wished_rate();
+  void plan(double rate);
+  bool filter();
+  void progress(double target, bool stop_inside);
+  void advance_command(int sub);
+  void measure(double t, int sub, const Eigen::VectorXd& q);
+  void measure_distances(double t);
+  void servo(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::Vector3d& tool);
+  void take_box(int g);
+  double bound_gap(int g1, int g2) const;
+
+  const Scene& scene_;
+  const BoundsTrajectory& bounds_;
+  const SimulateOptions& options_;
+  const int n_;
+  ModelPtr model_;
+  DataPtr data_, scratch_;  // the simulation; kinematics of nominal configurations
+  double dt_ = 0, hc_ = 0;
+  int substeps_ = 1;
+  std::vector<int> qadr_, vadr_;
+  Eigen::VectorXd vmax_;
+  int site_ = -1, tool_body_ = -1;
+  std::vector<JointMpc> mpcs_;
+  Human human_;
+  SimulationReport report_;
+
+  // The command (position, speed, acceleration), the admitted deviation and the progress.
+  Eigen::VectorXd qc_, vc_, ac_, dev_, dev_rate_;
+  double s_ = 0, s_from_ = 0, s_to_ = 0, rate_prev_ = 0, reached_at_ = -1;
+  Eigen::VectorXd nom_, lo_, hi_;  // the box at s_
+  Eigen::Vector3d force_ = Eigen::Vector3d::Zero(), torque_ = Eigen::Vector3d::Zero();
+  double force_sq_sum_ = 0;
+  long force_samples_ = 0;
+  Eigen::VectorXd human_gen_;  // J^T w over all dofs
+  std::vector<mjtNum> jacp_, jacr_, acc_, mass_acc_;
+
+  // The MPC's stages: their ends [s after now] and the boxes at their predicted s.
+  Eigen::VectorXd stage_end_;
+  std::vector<Eigen::VectorXd> stage_lo_, stage_hi_, stage_nom_;
+  Eigen::VectorXd ref_, lower_, upper_, n_k_, lo_k_, hi_k_;
+
+  // The distance measurement's boxes: the cell's taken once, the robot's at every step.
+  std::vector<Box> boxes_;
+  std::vector<Aabb> box_bounds_;
+  std::vector<int> robot_geoms_;
+  bool contact_now_ = false;
+};
+
+ClosedLoop::ClosedLoop(const Scene& scene, const BoundsTrajectory& bounds, const SimulateOptions& options)
+    : scene_(scene),
+      bounds_(bounds),
+      options_(options),
+      n_(scene.dof()),
+      model_(mj_copyModel(nullptr, &scene.model())),  // a copy: the scene is not changed
+      human_(scene, options.human, options.seed, options.control_period) {
+  if (bounds.dof() != n_)
     throw InputError("simulate: the bounds have " + std::to_string(bounds.dof()) + " joints, the cell " +
-                     std::to_string(n));
-
-  // A copy of the model, so that the scene is not changed.
-  ModelPtr model(mj_copyModel(nullptr, &scene.model()));
-  mjModel& m = *model;
+                     std::to_string(n_));
+  mjModel& m = *model_;
   m.opt.integrator = mjINT_EULER;  // mj_step1/mj_step2 need it
-  const double dt = m.opt.timestep;
-  const int substeps = static_cast<int>(std::lround(options.control_period / dt));
-  if (substeps < 1 || std::abs(substeps * dt - options.control_period) > 1e-9 * options.control_period)
-    throw InputError("simulate: the control period " + format_number(options.control_period) +
-                     " s is not a multiple of the cell's timestep " + format_number(dt) + " s (" +
+  dt_ = m.opt.timestep;
+  hc_ = options.control_period;
+  substeps_ = static_cast<int>(std::lround(hc_ / dt_));
+  if (substeps_ < 1 || std::abs(substeps_ * dt_ - hc_) > 1e-9 * hc_)
+    throw InputError("simulate: the control period " + format_number(hc_) +
+                     " s is not a multiple of the cell's timestep " + format_number(dt_) + " s (" +
                      scene.source() + ", <option timestep>)");
-  const double hc = options.control_period;
-
-  DataPtr data = make_data(m);
-  mjData& d = *data;
-  DataPtr scratch = make_data(m);  // kinematics of nominal configurations
-
-  std::vector<int> qadr(n), vadr(n);
-  Eigen::VectorXd vmax(n);
-  for (int j = 0; j < n; ++j) {
-    const RobotJoint& joint = scene.joints()[j];
-    qadr[j] = m.jnt_qposadr[joint.id];
-    vadr[j] = m.jnt_dofadr[joint.id];
-    vmax[j] = joint.max_speed > 0 ? options.speed_scale * joint.max_speed : options.default_speed;
-  }
-  const int site = scene.tool_site();
-  const int tool_body = m.site_bodyid[site];
-
-  std::vector<JointMpc> mpcs;
-  for (int j = 0; j < n; ++j) {
+  data_ = make_data(m);
+  scratch_ = make_data(m);
+  qadr_.resize(static_cast<size_t>(n_));
+  vadr_.resize(static_cast<size_t>(n_));
+  vmax_.resize(n_);
+  for (int j = 0; j < n_; ++j) {
+    const RobotJoint& joint = scene.joints()[static_cast<size_t>(j)];
+    qadr_[static_cast<size_t>(j)] = m.jnt_qposadr[joint.id];
+    vadr_[static_cast<size_t>(j)] = m.jnt_dofadr[joint.id];
+    vmax_[j] = joint.max_speed > 0 ? options.speed_scale * joint.max_speed : options.default_speed;
     JointMpcOptions o = options.mpc;
-    o.max_speed = vmax[j];
+    o.max_speed = vmax_[j];
     o.max_accel = options.max_accel;
-    mpcs.emplace_back(o);
+    mpcs_.emplace_back(o);
   }
+  site_ = scene.tool_site();
+  tool_body_ = m.site_bodyid[site_];
 
-  Human human(scene, options.human, options.seed, hc);
+  const auto nv = static_cast<size_t>(m.nv);
+  jacp_.resize(3 * nv);
+  jacr_.resize(3 * nv);
+  acc_.resize(nv);
+  mass_acc_.resize(nv);
+  human_gen_ = Eigen::VectorXd::Zero(m.nv);
+  const JointMpcOptions& mo = options.mpc;
+  stage_end_.resize(mo.horizon);
+  for (int k = 0; k < mo.horizon; ++k) stage_end_[k] = k ? stage_end_[k - 1] + mo.period : mo.first_period;
+  stage_lo_.assign(static_cast<size_t>(mo.horizon), Eigen::VectorXd(n_));
+  stage_hi_ = stage_nom_ = stage_lo_;
+  ref_.resize(mo.horizon);
+  lower_.resize(mo.horizon);
+  upper_.resize(mo.horizon);
+  n_k_.resize(n_);
+  lo_k_.resize(n_);
+  hi_k_.resize(n_);
 
-  // Path progress: ds/dt at s under the nominal timing (a segment of zero duration is passed at once).
-  const auto& times = bounds.times();
-  const double s_end = bounds.s_end();
-  const auto nominal_rate = [&](double s) {
-    const int i = std::min(static_cast<int>(s), std::max(0, bounds.waypoint_count() - 2));
-    const double duration = bounds.waypoint_count() > 1 ? times[i + 1] - times[i] : 0;
-    return duration > 0 ? 1.0 / duration : 1e6;
-  };
-  // dq/ds of the segment at s (the last segment's at the end).
-  const auto path_slope = [&](double s) -> Eigen::VectorXd {
-    if (bounds.waypoint_count() < 2) return Eigen::VectorXd::Zero(n);
-    const int i = std::min(static_cast<int>(s), bounds.waypoint_count() - 2);
-    return bounds.waypoints()[static_cast<size_t>(i) + 1].q - bounds.waypoints()[static_cast<size_t>(i)].q;
-  };
-  const auto tool_at = [&](const Eigen::VectorXd& q) {
-    scene.set_qpos(*scratch, q);
-    mj_kinematics(&m, scratch.get());
-    return Eigen::Vector3d(scratch->site_xpos[3 * site], scratch->site_xpos[3 * site + 1],
-                           scratch->site_xpos[3 * site + 2]);
-  };
-
-  SimulationReport report;
-  report.timestep = dt;
-  report.nominal_duration = bounds.duration();
-  report.waypoint_times.assign(bounds.waypoint_count(), std::numeric_limits<double>::quiet_NaN());
-  report.waypoint_times[0] = 0;
-  report.freedom_used = Eigen::VectorXd::Zero(n);
-  report.max_deviation = Eigen::VectorXd::Zero(n);
-  report.min_distance = options.distance_range;
-  report.min_distance_capped = true;
-  const double max_time =
-      options.max_time > 0 ? options.max_time : 3 * bounds.duration() / options.speed + options.end_hold + 5;
+  report_.timestep = dt_;
+  report_.nominal_duration = bounds.duration();
+  report_.waypoint_times.assign(static_cast<size_t>(bounds.waypoint_count()),
+                                std::numeric_limits<double>::quiet_NaN());
+  report_.waypoint_times[0] = 0;
+  report_.freedom_used = Eigen::VectorXd::Zero(n_);
+  report_.max_deviation = Eigen::VectorXd::Zero(n_);
+  report_.min_distance = options.distance_range;
+  report_.min_distance_capped = true;
 
   // The start: the first waypoint's nominal configuration, at rest.
-  Eigen::VectorXd nom(n), lo(n), hi(n);
-  bounds.at_s(0, nom, lo, hi);
-  scene.set_qpos(d, nom);
-  mj_forward(&m, &d);
+  nom_.resize(n_);
+  lo_.resize(n_);
+  hi_.resize(n_);
+  bounds.at_s(0, nom_, lo_, hi_);
+  scene.set_qpos(*data_, nom_);
+  mj_forward(&m, data_.get());
+  qc_ = nom_;
+  vc_ = ac_ = dev_ = dev_rate_ = Eigen::VectorXd::Zero(n_);
 
-  Eigen::VectorXd qc = nom, vc = Eigen::VectorXd::Zero(n), ac = Eigen::VectorXd::Zero(n);
-  Eigen::VectorXd dev = Eigen::VectorXd::Zero(n), dev_rate = Eigen::VectorXd::Zero(n);
-  double s = 0, s_from = 0, s_to = 0;
-  double reached_at = -1;
-  double rate_prev = 0;  // ds/dt of the last control period
-  Eigen::Vector3d force = Eigen::Vector3d::Zero(), torque = Eigen::Vector3d::Zero();
-  double force_sq_sum = 0;
-  long force_samples = 0;
-
-  const double kp_omega = 2 * kPi * options.servo_bandwidth;
-  const double kp = kp_omega * kp_omega, kd = 2 * kp_omega;
-  std::vector<mjtNum> jacp(3 * m.nv), jacr(3 * m.nv), acc(m.nv), mass_acc(m.nv);
-  Eigen::VectorXd human_gen(m.nv);
-  const std::vector<RobotPair>& self_pairs = scene.self_pairs();
-  // The boxes of the distance measurement: the cell's are fixed (taken once), the robot's are taken
-  // at every step for the geoms that move or pair with one.
-  std::vector<Box> boxes(static_cast<size_t>(m.ngeom));
-  std::vector<Aabb> box_bounds(static_cast<size_t>(m.ngeom));
-  std::vector<int> robot_geoms = scene.link_geoms();
-  for (const RobotPair& p : self_pairs)
+  boxes_.resize(static_cast<size_t>(m.ngeom));
+  box_bounds_.resize(static_cast<size_t>(m.ngeom));
+  robot_geoms_ = scene.link_geoms();
+  for (const RobotPair& p : scene.self_pairs())
     for (int g : {p.geom1, p.geom2})
-      if (std::find(robot_geoms.begin(), robot_geoms.end(), g) == robot_geoms.end()) robot_geoms.push_back(g);
-  const auto take_box = [&](int g) {
-    const Box b = geom_box(m, d, g);
-    const Eigen::Vector3d extent = b.rotation.cwiseAbs() * b.half_size;
-    boxes[static_cast<size_t>(g)] = b;
-    box_bounds[static_cast<size_t>(g)] = {b.center - extent, b.center + extent};
-  };
-  mj_kinematics(&m, &d);
+      if (std::find(robot_geoms_.begin(), robot_geoms_.end(), g) == robot_geoms_.end())
+        robot_geoms_.push_back(g);
   for (int o : scene.obstacle_geoms())
     if (has_bounding_box(m, o)) take_box(o);
-  // A lower bound of the distance between two geoms' boxes: the gap between their bounding boxes.
-  const auto bound_gap = [&](int g1, int g2) {
-    const Aabb& a = box_bounds[static_cast<size_t>(g1)];
-    const Aabb& b = box_bounds[static_cast<size_t>(g2)];
-    const Eigen::Vector3d gap = (a.lo - b.hi).cwiseMax(b.lo - a.hi).cwiseMax(0.0);
-    return gap.norm();
+}
+
+Eigen::Vector3d ClosedLoop::tool_at(const Eigen::VectorXd& q) {
+  scene_.set_qpos(*scratch_, q);
+  mj_kinematics(model_.get(), scratch_.get());
+  const mjtNum* p = scratch_->site_xpos + 3 * site_;
+  return {p[0], p[1], p[2]};
+}
+
+// The push's generalized force J^T w at the current state.
+void ClosedLoop::push_on_joints() {
+  const mjModel& m = *model_;
+  mj_jacSite(&m, data_.get(), jacp_.data(), jacr_.data(), site_);
+  for (int i = 0; i < m.nv; ++i) {
+    double g = 0;
+    for (int r = 0; r < 3; ++r)
+      g += jacp_[static_cast<size_t>(r * m.nv + i)] * force_[r] +
+           jacr_[static_cast<size_t>(r * m.nv + i)] * torque_[r];
+    human_gen_[i] = g;
+  }
+}
+
+void ClosedLoop::start_period(double t, const Eigen::Vector3d& tool) {
+  std::tie(force_, torque_) = human_.wrench(t, *data_, tool);
+  force_sq_sum_ += force_.squaredNorm();
+  ++force_samples_;
+  report_.max_force = std::max(report_.max_force, force_.norm());
+  push_on_joints();
+  // Admittance per joint: M d'' + D d' = (J^T w)_i.
+  for (int j = 0; j < n_; ++j) {
+    const double tau = human_gen_[vadr_[static_cast<size_t>(j)]];
+    dev_rate_[j] += hc_ * (tau - options_.admittance_damping * dev_rate_[j]) / options_.admittance_inertia;
+    dev_[j] += hc_ * dev_rate_[j];
+  }
+  bounds_.at_s(s_, nom_, lo_, hi_);
+  const double rate = wished_rate();
+  plan(rate);
+  const bool stop_inside = filter();
+  progress(std::min(bounds_.s_end(), s_ + rate * hc_), stop_inside);
+
+  double ratio = 0;
+  for (int j = 0; j < n_; ++j)
+    ratio =
+        std::max({ratio, std::abs(ac_[j]) / options_.max_accel, std::abs(vc_[j] + hc_ * ac_[j]) / vmax_[j]});
+  if (ratio > 1 + 1e-6) ++report_.limit_steps;
+  report_.max_limit_ratio = std::max(report_.max_limit_ratio, ratio);
+}
+
+// The progress the controller wishes for this period [ds/dt]: the nominal rate times the speed,
+// limited so that following the nominal path alone needs at most half of each joint's speed and
+// acceleration limits (the rest is the co-worker's), ramping up from the last period's and down to
+// a stop at the end, and slowed by a push against the tool's direction of travel.
+double ClosedLoop::wished_rate() {
+  const double s_end = bounds_.s_end();
+  const Eigen::Vector3d ahead = tool_at(bounds_.at_s(std::min(s_end, s_ + 0.01)).nominal) - tool_at(nom_);
+  double slow = 1;
+  if (ahead.norm() > 1e-9) {
+    const double against = std::max(0.0, -force_.dot(ahead.normalized()));
+    slow = std::clamp(1 - against / options_.hold_force, 0.0, 1.0);
+  }
+  // The nominal rate and dq/ds of the segment at s (a segment of zero duration is passed at once).
+  const int last = std::max(0, bounds_.waypoint_count() - 2);
+  const int i = std::min(static_cast<int>(s_), last);
+  const auto& times = bounds_.times();
+  const double duration =
+      bounds_.waypoint_count() > 1 ? times[static_cast<size_t>(i) + 1] - times[static_cast<size_t>(i)] : 0;
+  const double nominal_rate = duration > 0 ? 1.0 / duration : 1e6;
+  const Eigen::VectorXd slope = bounds_.waypoint_count() > 1
+                                    ? Eigen::VectorXd(bounds_.waypoints()[static_cast<size_t>(i) + 1].q -
+                                                      bounds_.waypoints()[static_cast<size_t>(i)].q)
+                                    : Eigen::VectorXd::Zero(n_);
+  double rate_max = options_.speed * nominal_rate, accel_s = kInf;
+  for (int j = 0; j < n_; ++j)
+    if (std::abs(slope[j]) > 1e-12) {
+      rate_max = std::min(rate_max, 0.5 * vmax_[j] / std::abs(slope[j]));
+      accel_s = std::min(accel_s, 0.5 * options_.max_accel / std::abs(slope[j]));
+    }
+  double rate = std::min(rate_max * slow, rate_prev_ + accel_s * hc_);
+  if (std::isfinite(accel_s)) rate = std::min(rate, std::sqrt(2 * accel_s * std::max(0.0, s_end - s_)));
+  return std::max(rate, 0.0);
+}
+
+// The controller's acceleration per joint (ac_): the MPC over the boxes at the s the wished rate
+// predicts, or the projection baseline.
+void ClosedLoop::plan(double rate) {
+  const JointMpcOptions& mo = options_.mpc;
+  const double s_end = bounds_.s_end();
+  for (size_t k = 0; k < static_cast<size_t>(mo.horizon); ++k)
+    bounds_.at_s(std::min(s_end, s_ + rate * stage_end_[static_cast<Eigen::Index>(k)]), stage_nom_[k],
+                 stage_lo_[k], stage_hi_[k]);
+  // The first stage also stays in the box at the current s, so that progress can wait for it.
+  for (int j = 0; j < n_; ++j) {
+    const double l = std::max(stage_lo_[0][j], lo_[j]), u = std::min(stage_hi_[0][j], hi_[j]);
+    if (l <= u) {
+      stage_lo_[0][j] = l;
+      stage_hi_[0][j] = u;
+    }
+  }
+  for (int j = 0; j < n_; ++j) {
+    if (options_.controller == ControllerKind::kMpc) {
+      for (size_t k = 0; k < static_cast<size_t>(mo.horizon); ++k) {
+        const auto e = static_cast<Eigen::Index>(k);
+        lower_[e] = stage_lo_[k][j] + margin(stage_lo_[k][j], stage_hi_[k][j]);
+        upper_[e] = stage_hi_[k][j] - margin(stage_lo_[k][j], stage_hi_[k][j]);
+        ref_[e] = std::clamp(stage_nom_[k][j] + dev_[j] + dev_rate_[j] * stage_end_[e], lower_[e], upper_[e]);
+      }
+      ac_[j] = mpcs_[static_cast<size_t>(j)].solve(qc_[j], vc_[j], ref_, lower_, upper_).accel[0];
+      continue;
+    }
+    // The baseline: the admitted target clamped into the next box, approached no faster than can
+    // stop at the box's edge (v^2 <= 2 a_max d, in discrete time), within the limits.
+    const double low = stage_lo_[0][j] + margin(stage_lo_[0][j], stage_hi_[0][j]);
+    const double high = stage_hi_[0][j] - margin(stage_lo_[0][j], stage_hi_[0][j]);
+    const double goal = std::clamp(stage_nom_[0][j] + dev_[j], low, high);
+    const double ah = options_.max_accel * hc_;
+    const auto stop_speed = [&](double room) {
+      return -ah + std::sqrt(ah * ah + 2 * options_.max_accel * std::max(0.0, room));
+    };
+    const double v_goal = std::clamp((goal - qc_[j]) / hc_, std::max(-vmax_[j], -stop_speed(qc_[j] - low)),
+                                     std::min(vmax_[j], stop_speed(high - qc_[j])));
+    ac_[j] = std::clamp((v_goal - vc_[j]) / hc_, -options_.max_accel, options_.max_accel);
+  }
+}
+
+// The safety filter: each joint's acceleration becomes the one nearest the controller's that keeps
+// the command at the period's end, and its stopping point, inside the box at the current s, within
+// the limits; so the command can always stay inside the box whatever progress does next. Returns
+// false when some joint could not (a box narrower than the motion needs, such as a bound of zero
+// width on a moving path): that joint brakes toward the box and the clamp keeps it inside.
+bool ClosedLoop::filter() {
+  bool stop_inside = true;
+  for (int j = 0; j < n_; ++j) {
+    const double low = lo_[j] + margin(lo_[j], hi_[j]), high = hi_[j] - margin(lo_[j], hi_[j]);
+    const AccelInterval r =
+        stay_and_stop_within(qc_[j], vc_[j], hc_, low, high, vmax_[j], options_.max_accel);
+    if (r.from <= r.to) {
+      ac_[j] = std::clamp(ac_[j], r.from, r.to);
+    } else {
+      const double v = vc_[j];
+      const double stop = qc_[j] + hc_ * v + v * std::abs(v) / (2 * options_.max_accel);
+      ac_[j] = stop > high ? r.a_min : r.a_max;
+      stop_inside = false;
+    }
+  }
+  return stop_inside;
+}
+
+// Progress: as far toward `target` as keeps the command at the period's end, and its stopping point,
+// inside the box (the path waits for the command).
+void ClosedLoop::progress(double target, bool stop_inside) {
+  const Eigen::VectorXd q_end = qc_ + hc_ * vc_ + 0.5 * hc_ * hc_ * ac_;
+  const Eigen::VectorXd v_end = vc_ + hc_ * ac_;
+  const auto inside = [&](double s_next) {
+    bounds_.at_s(s_next, n_k_, lo_k_, hi_k_);
+    for (int j = 0; j < n_; ++j) {
+      const double stop = q_end[j] + v_end[j] * std::abs(v_end[j]) / (2 * options_.max_accel);
+      if (q_end[j] < lo_k_[j] || q_end[j] > hi_k_[j]) return false;
+      const double m = margin(lo_k_[j], hi_k_[j]);
+      if (stop_inside && (stop < lo_k_[j] + m || stop > hi_k_[j] - m)) return false;
+    }
+    return true;
   };
+  double reached = target;
+  if (!inside(target)) {
+    double ok = s_, bad = target;
+    for (int it = 0; it < 20; ++it) {
+      const double mid = 0.5 * (ok + bad);
+      (inside(mid) ? ok : bad) = mid;
+    }
+    reached = ok;
+  }
+  s_from_ = s_;
+  s_to_ = reached;
+  rate_prev_ = (s_to_ - s_from_) / hc_;
+}
 
-  // Stage ends of the MPC's horizon [s after now].
-  const JointMpcOptions& mo = options.mpc;
-  Eigen::VectorXd stage_end(mo.horizon);
-  for (int k = 0; k < mo.horizon; ++k) stage_end[k] = (k ? stage_end[k - 1] + mo.period : mo.first_period);
+// One physics step's progress and command; a command outside the box at its s is put on the box's
+// edge, moving as the edge moves (the clamp); the admitted deviation does not wind up past the box.
+void ClosedLoop::advance_command(int sub) {
+  s_ = s_from_ + (s_to_ - s_from_) * (sub + 1) / substeps_;
+  const Eigen::VectorXd lo_before = lo_, hi_before = hi_;
+  bounds_.at_s(s_, nom_, lo_, hi_);
+  qc_ += dt_ * vc_ + 0.5 * dt_ * dt_ * ac_;
+  vc_ += dt_ * ac_;
+  bool clamped = false;
+  for (int j = 0; j < n_; ++j) {
+    if (qc_[j] < lo_[j]) {
+      qc_[j] = lo_[j];
+      vc_[j] = std::max(vc_[j], (lo_[j] - lo_before[j]) / dt_);
+      clamped = true;
+    } else if (qc_[j] > hi_[j]) {
+      qc_[j] = hi_[j];
+      vc_[j] = std::min(vc_[j], (hi_[j] - hi_before[j]) / dt_);
+      clamped = true;
+    }
+  }
+  if (clamped) ++report_.clamp_steps;
+  if (sub + 1 == substeps_)
+    for (int j = 0; j < n_; ++j) {
+      const double d_lo = lo_[j] - nom_[j], d_hi = hi_[j] - nom_[j];
+      if (dev_[j] < d_lo || dev_[j] > d_hi) {
+        dev_[j] = std::clamp(dev_[j], d_lo, d_hi);
+        dev_rate_[j] = 0;
+      }
+    }
+}
 
-  Eigen::VectorXd n_k(n), lo_k(n), hi_k(n);
-  Eigen::VectorXd ref(mo.horizon), lower(mo.horizon), upper(mo.horizon);
-  std::vector<Eigen::VectorXd> stage_lo(mo.horizon, Eigen::VectorXd(n)),
-      stage_hi(mo.horizon, Eigen::VectorXd(n)), stage_nom(mo.horizon, Eigen::VectorXd(n));
+// The state a step starts from against the box at its s, then its contacts and distances. The
+// controller's figures count until the first contact: after it, contact forces move the robot.
+void ClosedLoop::measure(double t, int sub, const Eigen::VectorXd& q) {
+  const double s_now = s_from_ + (s_to_ - s_from_) * sub / substeps_;
+  bounds_.at_s(s_now, n_k_, lo_k_, hi_k_);
+  for (int j = 0; j < n_ && !report_.first_contact; ++j) {
+    report_.max_excursion = std::max({report_.max_excursion, lo_k_[j] - q[j], q[j] - hi_k_[j]});
+    const double dq = q[j] - n_k_[j];
+    report_.max_deviation[j] = std::max(report_.max_deviation[j], std::abs(dq));
+    const double room = dq >= 0 ? hi_k_[j] - n_k_[j] : n_k_[j] - lo_k_[j];
+    if (room > 1e-12)
+      report_.freedom_used[j] = std::max(report_.freedom_used[j], std::min(1.0, std::abs(dq) / room));
+  }
+  measure_distances(t);
+  if (contact_now_) ++report_.contact_steps;
+}
 
-  // The push's generalized force J^T w at the current state.
-  const auto push_on_joints = [&] {
-    mj_jacSite(&m, &d, jacp.data(), jacr.data(), site);
-    for (int i = 0; i < m.nv; ++i) {
-      double g = 0;
-      for (int r = 0; r < 3; ++r) g += jacp[r * m.nv + i] * force[r] + jacr[r * m.nv + i] * torque[r];
-      human_gen[i] = g;
+void ClosedLoop::take_box(int g) {
+  const Box b = geom_box(*model_, *data_, g);
+  const Eigen::Vector3d extent = b.rotation.cwiseAbs() * b.half_size;
+  boxes_[static_cast<size_t>(g)] = b;
+  box_bounds_[static_cast<size_t>(g)] = {b.center - extent, b.center + extent};
+}
+
+// A lower bound of the distance between two geoms' boxes: the gap between their bounding boxes.
+double ClosedLoop::bound_gap(int g1, int g2) const {
+  const Aabb& a = box_bounds_[static_cast<size_t>(g1)];
+  const Aabb& b = box_bounds_[static_cast<size_t>(g2)];
+  return (a.lo - b.hi).cwiseMax(b.lo - a.hi).cwiseMax(0.0).norm();
+}
+
+// MuJoCo's own contacts (mj_step1's collision at the cell's margins: links against the cell) and its
+// narrowphase on every counted self pair; the smallest distance from the geoms' boxes, for the pairs
+// whose bounding boxes can beat the smallest so far (the run's minimum is exact, and most pairs are
+// left out after the first steps).
+void ClosedLoop::measure_distances(double t) {
+  const mjModel& m = *model_;
+  const mjData& d = *data_;
+  contact_now_ = false;
+  const auto near = [&](int g1, int g2, double dist) {
+    if (dist <= options_.distance_range && (report_.min_distance_capped || dist < report_.min_distance)) {
+      report_.min_distance = std::max(0.0, dist);
+      report_.min_distance_geom1 = scene_.geom_label(g1);
+      report_.min_distance_geom2 = scene_.geom_label(g2);
+      report_.min_distance_t = t;
+      report_.min_distance_capped = false;
     }
   };
+  const auto touch = [&](int g1, int g2, double depth, bool self) {
+    contact_now_ = true;
+    near(g1, g2, 0);
+    if (!report_.first_contact)
+      report_.first_contact = SimContact{t, scene_.geom_label(g1), scene_.geom_label(g2), depth, self};
+  };
+  for (int c = 0; c < d.ncon; ++c) {
+    const mjContact& con = d.contact[c];
+    const bool first_is_link = scene_.role(con.geom1) == GeomRole::kLink;
+    touch(first_is_link ? con.geom1 : con.geom2, first_is_link ? con.geom2 : con.geom1,
+          std::max(0.0, -static_cast<double>(con.dist)), false);
+  }
+  const auto reach = [&] {
+    return report_.min_distance_capped ? options_.distance_range : report_.min_distance;
+  };
+  const auto box = [&](int g) -> const Box& { return boxes_[static_cast<size_t>(g)]; };
+  for (int g : robot_geoms_) take_box(g);
+  for (const RobotPair& p : scene_.self_pairs()) {
+    if (geoms_touch(m, d, p.geom1, p.geom2))
+      touch(p.geom1, p.geom2, box_penetration(box(p.geom1), box(p.geom2)), true);
+    else if (bound_gap(p.geom1, p.geom2) <= reach())
+      near(p.geom1, p.geom2, box_distance(box(p.geom1), box(p.geom2)));
+  }
+  const StaticGeoms& statics = scene_.statics();
+  for (int l : scene_.link_geoms()) {
+    Aabb query = box_bounds_[static_cast<size_t>(l)];
+    query.lo.array() -= reach();
+    query.hi.array() += reach();
+    statics.grid.any(query, [&](int i) {
+      const int o = statics.geoms[static_cast<size_t>(i)];
+      if (scene_.role(o) == GeomRole::kObstacle && has_bounding_box(m, o) && bound_gap(l, o) <= reach())
+        near(l, o, box_distance(box(l), box(o)));
+      return false;
+    });
+  }
+}
 
-  const long total_steps = static_cast<long>(std::ceil(max_time / dt));
+// The servo: computed torque from the model (M a + bias - passive), with the acceleration that puts
+// each joint exactly on its next command after MuJoCo's (semi-implicit Euler) step, minus the push
+// that the wrist's force sensor measures, so that the push moves the robot only through the
+// admittance. The model is its own plant, so the robot is where it is commanded to be until a
+// contact's forces act on it. The push itself acts at the tool site.
+void ClosedLoop::servo(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::Vector3d& tool) {
+  const mjModel& m = *model_;
+  mjData& d = *data_;
+  for (int i = 0; i < m.nv; ++i) acc_[static_cast<size_t>(i)] = -d.qvel[i] / dt_;  // other joints: held
+  for (int j = 0; j < n_; ++j)
+    acc_[static_cast<size_t>(vadr_[static_cast<size_t>(j)])] = (qc_[j] - q[j] - dt_ * v[j]) / (dt_ * dt_);
+  mj_mulM(&m, &d, mass_acc_.data(), acc_.data());
+  // MuJoCo's Euler step integrates joint damping implicitly, (M + dt D) qacc = force: add dt D a.
+  for (int i = 0; i < m.nv; ++i) {
+    const auto u = static_cast<size_t>(i);
+    d.qfrc_applied[i] =
+        mass_acc_[u] + dt_ * m.dof_damping[i] * acc_[u] + d.qfrc_bias[i] - d.qfrc_passive[i] - human_gen_[i];
+  }
+  // MuJoCo's xfrc_applied acts at the body's centre of mass: move the push there.
+  const Eigen::Vector3d com(d.xipos[3 * tool_body_], d.xipos[3 * tool_body_ + 1],
+                            d.xipos[3 * tool_body_ + 2]);
+  const Eigen::Vector3d moment = torque_ + (tool - com).cross(force_);
+  for (int r = 0; r < 3; ++r) {
+    d.xfrc_applied[6 * tool_body_ + r] = force_[r];
+    d.xfrc_applied[6 * tool_body_ + 3 + r] = moment[r];
+  }
+}
+
+SimulationReport ClosedLoop::run(const FrameCallback& on_frame) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  mjModel& m = *model_;
+  mjData& d = *data_;
+  const double max_time = options_.max_time > 0
+                              ? options_.max_time
+                              : 3 * bounds_.duration() / options_.speed + options_.end_hold + 5;
+  const long total_steps = static_cast<long>(std::ceil(max_time / dt_));
+  Eigen::VectorXd q(n_), v(n_);
   for (long step = 0; step < total_steps; ++step) {
-    const double t = static_cast<double>(step) * dt;
-    const int sub = static_cast<int>(step % substeps);
+    const double t = static_cast<double>(step) * dt_;
+    const int sub = static_cast<int>(step % substeps_);
     mj_step1(&m, &d);  // kinematics, contacts, mass matrix and bias forces at the current state
-
-    Eigen::VectorXd q(n), v(n);
-    for (int j = 0; j < n; ++j) {
-      q[j] = d.qpos[qadr[j]];
-      v[j] = d.qvel[vadr[j]];
+    for (int j = 0; j < n_; ++j) {
+      q[j] = d.qpos[qadr_[static_cast<size_t>(j)]];
+      v[j] = d.qvel[vadr_[static_cast<size_t>(j)]];
     }
-    const Eigen::Vector3d tool(d.site_xpos[3 * site], d.site_xpos[3 * site + 1], d.site_xpos[3 * site + 2]);
-
+    const Eigen::Vector3d tool(d.site_xpos[3 * site_], d.site_xpos[3 * site_ + 1],
+                               d.site_xpos[3 * site_ + 2]);
+    if (!report_.first_contact)
+      report_.max_tracking_error = std::max(report_.max_tracking_error, (q - qc_).cwiseAbs().maxCoeff());
     if (sub == 0) {
-      // The controller's period starts: the push, the admittance, the progress and the plan.
-      std::tie(force, torque) = human.wrench(t, d, tool);
-      force_sq_sum += force.squaredNorm();
-      ++force_samples;
-      report.max_force = std::max(report.max_force, force.norm());
-      push_on_joints();
-      // Admittance per joint: M dd + D d = J^T w.
-      for (int j = 0; j < n; ++j) {
-        const double tau = human_gen[vadr[j]];
-        dev_rate[j] += hc * (tau - options.admittance_damping * dev_rate[j]) / options.admittance_inertia;
-        dev[j] += hc * dev_rate[j];
-      }
-      // Progress: the nominal rate scaled by the speed, slowed by a push against the direction of
-      // travel, and no farther than the command can follow within this period.
-      bounds.at_s(s, nom, lo, hi);
-      const Eigen::Vector3d ahead = tool_at(bounds.at_s(std::min(s_end, s + 0.01)).nominal) - tool_at(nom);
-      double slow = 1;
-      if (ahead.norm() > 1e-9) {
-        const double against = std::max(0.0, -force.dot(ahead.normalized()));
-        slow = std::clamp(1 - against / options.hold_force, 0.0, 1.0);
-      }
-      // The rate is limited so that following the nominal path alone needs at most half of each
-      // joint's speed and acceleration limits (the rest is the co-worker's), and ramps up and down.
-      const Eigen::VectorXd slope = path_slope(s);
-      double rate_max = options.speed * nominal_rate(s), accel_s = kInf;
-      for (int j = 0; j < n; ++j)
-        if (std::abs(slope[j]) > 1e-12) {
-          rate_max = std::min(rate_max, 0.5 * vmax[j] / std::abs(slope[j]));
-          accel_s = std::min(accel_s, 0.5 * options.max_accel / std::abs(slope[j]));
-        }
-      double rate = std::min({rate_max * slow, rate_prev + accel_s * hc});
-      if (std::isfinite(accel_s)) rate = std::min(rate, std::sqrt(2 * accel_s * std::max(0.0, s_end - s)));
-      rate = std::max(rate, 0.0);
-      const double target = std::min(s_end, s + rate * hc);
-
-      // The boxes and the reference over the horizon, the progress going on at the wished rate. The
-      // first stage also stays in the box at the current s, so that progress can always wait for
-      // the command (below).
-      for (int k = 0; k < mo.horizon; ++k) {
-        bounds.at_s(std::min(s_end, s + rate * stage_end[k]), stage_nom[k], stage_lo[k], stage_hi[k]);
-      }
-      for (int j = 0; j < n; ++j) {
-        const double l = std::max(stage_lo[0][j], lo[j]), u = std::min(stage_hi[0][j], hi[j]);
-        if (l <= u) {
-          stage_lo[0][j] = l;
-          stage_hi[0][j] = u;
-        }
-      }
-      for (int j = 0; j < n; ++j) {
-        double a = 0;
-        if (options.controller == ControllerKind::kMpc) {
-          for (int k = 0; k < mo.horizon; ++k) {
-            const double margin = std::min(options.plan_margin, 0.25 * (stage_hi[k][j] - stage_lo[k][j]));
-            lower[k] = stage_lo[k][j] + margin;
-            upper[k] = stage_hi[k][j] - margin;
-            ref[k] = std::clamp(stage_nom[k][j] + dev[j] + dev_rate[j] * stage_end[k], lower[k], upper[k]);
-          }
-          a = mpcs[j].solve(qc[j], vc[j], ref, lower, upper).accel[0];
-        } else {
-          // The baseline: the admitted target clamped into the next box, reached as fast as the
-          // limits allow.
-          const int k = 0;
-          const double margin = std::min(options.plan_margin, 0.25 * (stage_hi[k][j] - stage_lo[k][j]));
-          const double low = stage_lo[k][j] + margin, high = stage_hi[k][j] - margin;
-          const double goal = std::clamp(stage_nom[k][j] + dev[j], low, high);
-          // No faster toward a bound than can stop at it: v^2 <= 2 a_max d, in discrete time.
-          const double ah = options.max_accel * hc;
-          const auto stop_speed = [&](double room) {
-            return -ah + std::sqrt(ah * ah + 2 * options.max_accel * std::max(0.0, room));
-          };
-          const double v_goal = std::clamp((goal - qc[j]) / hc, std::max(-vmax[j], -stop_speed(qc[j] - low)),
-                                           std::min(vmax[j], stop_speed(high - qc[j])));
-          a = std::clamp((v_goal - vc[j]) / hc, -options.max_accel, options.max_accel);
-        }
-        ac[j] = a;
-      }
-      // The safety filter: each joint's acceleration is the one nearest the controller's that keeps
-      // the command inside the box at the current s with room to stop there (its stopping point at
-      // full deceleration inside the box), within the speed and acceleration limits. So the command
-      // can always stay inside the box, whatever the path's progress does next.
-      bool stop_inside_now = true;
-      for (int j = 0; j < n; ++j) {
-        const double margin = std::min(options.plan_margin, 0.25 * (hi[j] - lo[j]));
-        const double low = lo[j] + margin, high = hi[j] - margin;
-        const double a_min = std::max(-options.max_accel, (-vmax[j] - vc[j]) / hc);
-        const double a_max = std::min(options.max_accel, (vmax[j] - vc[j]) / hc);
-        const auto end_of = [&](double a, double& q1, double& stop) {
-          q1 = qc[j] + hc * vc[j] + 0.5 * hc * hc * a;
-          const double v1 = vc[j] + hc * a;
-          stop = q1 + v1 * std::abs(v1) / (2 * options.max_accel);
-        };
-        // Both the end and the stopping point grow with a: bisect for the interval of a that keeps
-        // both within [low, high].
-        const auto first_at_least = [&](double bound) {  // smallest a with end and stop >= bound
-          double q1 = 0, stop = 0;
-          end_of(a_min, q1, stop);
-          if (std::min(q1, stop) >= bound) return a_min;
-          end_of(a_max, q1, stop);
-          if (std::min(q1, stop) < bound) return kInf;
-          double lo_a = a_min, hi_a = a_max;
-          for (int it = 0; it < 50; ++it) {
-            const double mid = 0.5 * (lo_a + hi_a);
-            end_of(mid, q1, stop);
-            (std::min(q1, stop) >= bound ? hi_a : lo_a) = mid;
-          }
-          return hi_a;
-        };
-        const auto last_at_most = [&](double bound) {  // largest a with end and stop <= bound
-          double q1 = 0, stop = 0;
-          end_of(a_max, q1, stop);
-          if (std::max(q1, stop) <= bound) return a_max;
-          end_of(a_min, q1, stop);
-          if (std::max(q1, stop) > bound) return -kInf;
-          double lo_a = a_min, hi_a = a_max;
-          for (int it = 0; it < 50; ++it) {
-            const double mid = 0.5 * (lo_a + hi_a);
-            end_of(mid, q1, stop);
-            (std::max(q1, stop) <= bound ? lo_a : hi_a) = mid;
-          }
-          return lo_a;
-        };
-        const double from = first_at_least(low), to = last_at_most(high);
-        if (from <= to) {
-          ac[j] = std::clamp(ac[j], from, to);
-        } else {
-          // No acceleration can (the box is narrower than the motion needs, e.g. a bound of zero
-          // width on a moving path): brake toward the box; the clamp below keeps the command in it.
-          double q1 = 0, stop = 0;
-          end_of(0, q1, stop);
-          ac[j] = stop > high ? a_min : a_max;
-          stop_inside_now = false;
-        }
-      }
-      // Progress: as far toward the wished s as keeps the command where it will be at the period's
-      // end, and its stopping point, inside the box (the path waits for the command).
-      const Eigen::VectorXd q_end = qc + hc * vc + 0.5 * hc * hc * ac;
-      const Eigen::VectorXd v_end = vc + hc * ac;
-      const auto inside = [&](double s_next) {
-        bounds.at_s(s_next, n_k, lo_k, hi_k);
-        for (int j = 0; j < n; ++j) {
-          const double margin = std::min(options.plan_margin, 0.25 * (hi_k[j] - lo_k[j]));
-          const double stop = q_end[j] + v_end[j] * std::abs(v_end[j]) / (2 * options.max_accel);
-          if (q_end[j] < lo_k[j] || q_end[j] > hi_k[j]) return false;
-          if (stop_inside_now && (stop < lo_k[j] + margin || stop > hi_k[j] - margin)) return false;
-        }
-        return true;
-      };
-      double reached = target;
-      if (!inside(target)) {
-        double ok = s, bad = target;
-        for (int it = 0; it < 20; ++it) {
-          const double mid = 0.5 * (ok + bad);
-          (inside(mid) ? ok : bad) = mid;
-        }
-        reached = ok;
-      }
-      s_from = s;
-      s_to = reached;
-      rate_prev = (s_to - s_from) / hc;
-
-      double ratio = 0;
-      for (int j = 0; j < n; ++j)
-        ratio =
-            std::max({ratio, std::abs(ac[j]) / options.max_accel, std::abs(vc[j] + hc * ac[j]) / vmax[j]});
-      if (ratio > 1 + 1e-6) ++report.limit_steps;
-      report.max_limit_ratio = std::max(report.max_limit_ratio, ratio);
-
+      start_period(t, tool);
       if (on_frame) {
         SimFrame frame;
         frame.t = t;
-        frame.s = s;
+        frame.s = s_;
         frame.tool = tool;
-        frame.force = force;
-        frame.box = bounds.at_s(s);
+        frame.force = force_;
+        frame.box = bounds_.at_s(s_);
         on_frame(m, d, frame);
       }
+    } else {
+      push_on_joints();
     }
-
-    // This substep's progress and command; the command stays in the box at its s (the safety clamp).
-    s = s_from + (s_to - s_from) * (sub + 1) / substeps;
-    const Eigen::VectorXd lo_before = lo, hi_before = hi;
-    bounds.at_s(s, nom, lo, hi);
-    qc += dt * vc + 0.5 * dt * dt * ac;
-    vc += dt * ac;
-    bool clamped = false;
-    for (int j = 0; j < n; ++j) {
-      // A command outside the box is put on its edge, moving as the edge moves.
-      if (qc[j] < lo[j]) {
-        qc[j] = lo[j];
-        vc[j] = std::max(vc[j], (lo[j] - lo_before[j]) / dt);
-        clamped = true;
-      } else if (qc[j] > hi[j]) {
-        qc[j] = hi[j];
-        vc[j] = std::min(vc[j], (hi[j] - hi_before[j]) / dt);
-        clamped = true;
-      }
-    }
-    if (clamped) ++report.clamp_steps;
-    if (sub + 1 == substeps) {
-      // No wind-up: the admitted deviation stays where the bounds let the command go.
-      for (int j = 0; j < n; ++j) {
-        const double d_lo = lo[j] - nom[j], d_hi = hi[j] - nom[j];
-        if (dev[j] < d_lo || dev[j] > d_hi) {
-          dev[j] = std::clamp(dev[j], d_lo, d_hi);
-          dev_rate[j] = 0;
-        }
-      }
-    }
-    if (s >= s_end && reached_at < 0) reached_at = t + dt;
-    for (int i = static_cast<int>(std::floor(s_from)) + 1; i <= static_cast<int>(std::floor(s)); ++i)
-      if (i < bounds.waypoint_count() && std::isnan(report.waypoint_times[i]))
-        report.waypoint_times[i] = t + dt;
-
-    // Measure the state this step starts from (its contacts are mj_step1's).
-    {
-      Eigen::VectorXd n_now(n), lo_now(n), hi_now(n);
-      const double s_now = sub == 0 ? s_from : s_from + (s_to - s_from) * sub / substeps;
-      bounds.at_s(s_now, n_now, lo_now, hi_now);
-      // The controller's figures count until the first contact: after it, contact forces move the
-      // robot, and what follows is the collision's outcome, not the controller's.
-      for (int j = 0; j < n && !report.first_contact; ++j) {
-        const double out = std::max({0.0, lo_now[j] - q[j], q[j] - hi_now[j]});
-        report.max_excursion = std::max(report.max_excursion, out);
-        const double dq = q[j] - n_now[j];
-        report.max_deviation[j] = std::max(report.max_deviation[j], std::abs(dq));
-        const double room = dq >= 0 ? hi_now[j] - n_now[j] : n_now[j] - lo_now[j];
-        if (room > 1e-12)
-          report.freedom_used[j] = std::max(report.freedom_used[j], std::min(1.0, std::abs(dq) / room));
-      }
-      bool contact = false;
-      const auto near = [&](int g1, int g2, double dist) {
-        if (dist <= options.distance_range && (report.min_distance_capped || dist < report.min_distance)) {
-          report.min_distance = std::max(0.0, dist);
-          report.min_distance_geom1 = scene.geom_label(g1);
-          report.min_distance_geom2 = scene.geom_label(g2);
-          report.min_distance_t = t;
-          report.min_distance_capped = false;
-        }
-      };
-      const auto touch = [&](int g1, int g2, double depth, bool self) {
-        contact = true;
-        near(g1, g2, 0);
-        if (!report.first_contact)
-          report.first_contact = SimContact{t, scene.geom_label(g1), scene.geom_label(g2), depth, self};
-      };
-      // MuJoCo's own contacts (mj_step1's collision at the cell's margins: links against the cell),
-      // and MuJoCo's narrowphase on every counted self pair.
-      for (int c = 0; c < d.ncon; ++c) {
-        const mjContact& con = d.contact[c];
-        const bool first_is_link = scene.role(con.geom1) == GeomRole::kLink;
-        touch(first_is_link ? con.geom1 : con.geom2, first_is_link ? con.geom2 : con.geom1,
-              std::max(0.0, -static_cast<double>(con.dist)), false);
-      }
-      // Only pairs that may come nearer than the smallest distance so far are measured: the run's
-      // minimum is exact, and most pairs are left out after the first steps.
-      const auto reach = [&] {
-        return report.min_distance_capped ? options.distance_range : report.min_distance;
-      };
-      for (int g : robot_geoms) take_box(g);
-      for (const RobotPair& p : self_pairs) {
-        if (geoms_touch(m, d, p.geom1, p.geom2)) {
-          touch(p.geom1, p.geom2,
-                box_penetration(boxes[static_cast<size_t>(p.geom1)], boxes[static_cast<size_t>(p.geom2)]),
-                true);
-        } else if (bound_gap(p.geom1, p.geom2) <= reach()) {
-          near(p.geom1, p.geom2,
-               box_distance(boxes[static_cast<size_t>(p.geom1)], boxes[static_cast<size_t>(p.geom2)]));
-        }
-      }
-      // Distances to the cell: the obstacles whose boxes' bounds come within reach of a link's.
-      const StaticGeoms& statics = scene.statics();
-      for (int l : scene.link_geoms()) {
-        Aabb query = box_bounds[static_cast<size_t>(l)];
-        query.lo.array() -= reach();
-        query.hi.array() += reach();
-        statics.grid.any(query, [&](int i) {
-          const int o = statics.geoms[static_cast<size_t>(i)];
-          if (scene.role(o) == GeomRole::kObstacle && has_bounding_box(m, o) && bound_gap(l, o) <= reach())
-            near(l, o, box_distance(boxes[static_cast<size_t>(l)], boxes[static_cast<size_t>(o)]));
-          return false;
-        });
-      }
-      if (contact) ++report.contact_steps;
-    }
-
-    if (sub != 0) push_on_joints();
-    // The servo: computed torque from the model (M a + bias - passive), minus the push that the
-    // wrist's force sensor measures, so the push moves the robot only through the admittance.
-    for (int i = 0; i < m.nv; ++i) acc[i] = -kd * d.qvel[i];  // joints outside the robot: held still
-    double tracking = 0;
-    for (int j = 0; j < n; ++j) {
-      acc[vadr[j]] = ac[j] + kp * (qc[j] - q[j]) + kd * (vc[j] - v[j]);
-      tracking = std::max(tracking, std::abs(qc[j] - q[j]));
-    }
-    if (!report.first_contact) report.max_tracking_error = std::max(report.max_tracking_error, tracking);
-    mj_mulM(&m, &d, mass_acc.data(), acc.data());
-    // MuJoCo's Euler step integrates joint damping implicitly, (M + dt D) qacc = force: add dt D a.
-    for (int i = 0; i < m.nv; ++i)
-      d.qfrc_applied[i] =
-          mass_acc[i] + dt * m.dof_damping[i] * acc[i] + d.qfrc_bias[i] - d.qfrc_passive[i] - human_gen[i];
-    // The push itself, applied at the tool site: MuJoCo's xfrc_applied acts at the body's centre of mass.
-    const Eigen::Vector3d com(d.xipos[3 * tool_body], d.xipos[3 * tool_body + 1], d.xipos[3 * tool_body + 2]);
-    const Eigen::Vector3d moment = torque + (tool - com).cross(force);
-    for (int r = 0; r < 3; ++r) {
-      d.xfrc_applied[6 * tool_body + r] = force[r];
-      d.xfrc_applied[6 * tool_body + 3 + r] = moment[r];
-    }
+    measure(t, sub, q);
+    advance_command(sub);
+    if (s_ >= bounds_.s_end() && reached_at_ < 0) reached_at_ = t + dt_;
+    for (int i = static_cast<int>(std::floor(s_from_)) + 1; i <= static_cast<int>(std::floor(s_)); ++i)
+      if (i < bounds_.waypoint_count() && std::isnan(report_.waypoint_times[static_cast<size_t>(i)]))
+        report_.waypoint_times[static_cast<size_t>(i)] = t + dt_;
+    servo(q, v, tool);
     mj_step2(&m, &d);
-    ++report.steps;
-    if (reached_at >= 0 && t + dt >= reached_at + options.end_hold) break;
+    ++report_.steps;
+    if (reached_at_ >= 0 && t + dt_ >= reached_at_ + options_.end_hold) break;
   }
-  report.simulated_time = static_cast<double>(report.steps) * dt;
-  report.reached_end = reached_at >= 0;
-  report.end_time = report.reached_end ? reached_at : report.simulated_time;
-  report.left_bounds = report.max_excursion > 0;
-  report.rms_force = force_samples ? std::sqrt(force_sq_sum / static_cast<double>(force_samples)) : 0;
-  report.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  return report;
+  report_.simulated_time = static_cast<double>(report_.steps) * dt_;
+  report_.reached_end = reached_at_ >= 0;
+  report_.end_time = report_.reached_end ? reached_at_ : report_.simulated_time;
+  report_.left_bounds = report_.max_excursion > 0;
+  report_.rms_force = force_samples_ ? std::sqrt(force_sq_sum_ / static_cast<double>(force_samples_)) : 0;
+  report_.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  return report_;
+}
+
+}  // namespace
+
+SimulationReport simulate(const Scene& scene, const BoundsTrajectory& bounds, const SimulateOptions& options,
+                          const FrameCallback& on_frame) {
+  options.check();
+  return ClosedLoop(scene, bounds, options).run(on_frame);
 }
 
 const char* human_kind_name(HumanKind kind) {
@@ -764,7 +871,6 @@ nlohmann::json simulation_json(const Scene& scene, const SimulationReport& r, co
                      {"max_accel", o.max_accel},
                      {"speed_scale", o.speed_scale},
                      {"plan_margin", o.plan_margin},
-                     {"servo_bandwidth", o.servo_bandwidth},
                      {"admittance", {{"inertia", o.admittance_inertia}, {"damping", o.admittance_damping}}},
                      {"hold_force", o.hold_force}};
   if (o.controller == ControllerKind::kMpc)

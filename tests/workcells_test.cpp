@@ -41,6 +41,7 @@ std::vector<BundledCell> bundled_cells() {
       {"rail_hall", {{"patch", "patch", "trolley"}, {"mould", "mould", "mould"}}},
       {"shelf_bay", {{"pick", "pick", "table_low"}, {"place", "place", "table_high"}}},
       {"wide_elbow", {{"pick", "pick", "table"}, {"place", "place", "table"}}},
+      {"low_beam", {{"pick", "pick", "table_left"}, {"place", "place", "table_right"}}},
   };
 }
 

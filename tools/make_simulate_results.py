@@ -36,7 +36,10 @@ THESIS_PATHS = [("dallara", "home", "patch"), ("dallara", "patch", "mould"), ("d
                 ("dlr", "home", "patch"), ("dlr", "patch", "mould"), ("dlr", "mould", "home")]
 # Cells built for judging features on layouts nothing was tuned on (docs/workcells.md).
 NEW_PATHS = [("press_shop", "home", "pick"), ("press_shop", "pick", "place"), ("press_shop", "place", "home"),
-             ("rail_hall", "home", "patch"), ("rail_hall", "patch", "mould"), ("rail_hall", "mould", "home")]
+             ("rail_hall", "home", "patch"), ("rail_hall", "patch", "mould"), ("rail_hall", "mould", "home"),
+             ("shelf_bay", "home", "pick"), ("shelf_bay", "pick", "place"), ("shelf_bay", "place", "home"),
+             ("wide_elbow", "home", "pick"), ("wide_elbow", "pick", "place"), ("wide_elbow", "place", "home"),
+             ("low_beam", "home", "pick"), ("low_beam", "pick", "place"), ("low_beam", "place", "home")]
 BOUNDS = [("default", []), ("thesis", ["--preset", "thesis"])]
 # The numbers kept from each run's report (the rest of it, e.g. the controller's settings, is the same
 # for every run).

@@ -86,8 +86,6 @@ struct SimulateOptions {
   double hold_force = 80;
   //! How far inside the bounds the controller plans [rad or m] (at most a quarter of a bound's width).
   double plan_margin = 1e-3;
-  //! Low-level joint servo: the bandwidth of a computed-torque PD loop [Hz], critically damped.
-  double servo_bandwidth = 10;
   //! Distances up to this are measured [m]; farther ones are reported as "at least this".
   double distance_range = 0.5;
   double end_hold = 2.0;  //!< simulated time after the path's end is reached [s]

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Derives the goal keyframes of the three cells not used for tuning, mjcf/workcells/press_shop.xml
+# Derives the goal keyframes of the cells not used for tuning, mjcf/workcells/press_shop.xml
 # (fixed base: `pick`, `place`), mjcf/workcells/shelf_bay.xml (fixed base: `pick`,
-# `place`) and mjcf/workcells/rail_hall.xml (linear axis: `patch`, `mould`),
+# `place`), mjcf/workcells/rail_hall.xml (linear axis: `patch`, `mould`) and mjcf/workcells/low_beam.xml
+# (fixed base: `pick`; `place` is its mirror image, below),
 # with leeway's own inverse kinematics, as tools/dlr_keyframes.sh does for DLR: tool0 on the goal
 # site, tool pointing straight down, elbow-up branch (seeded there, j4 = -pi); j6 has no effect on
 # the position or the tool axis, so it keeps its seed, j6 = j1 as in the thesis poses. Fixed base:
@@ -45,3 +46,7 @@ derive mjcf/workcells/shelf_bay.xml place place
 echo "mjcf/workcells/rail_hall.xml:"
 derive mjcf/workcells/rail_hall.xml patch patch rail_x
 derive mjcf/workcells/rail_hall.xml mould mould rail_x
+# low_beam's place site is the mirror image of its pick site in the x-z plane: its keyframe is
+# pick's with j1 and j6 negated (the IK from this seed lands on the j4 = +pi branch there instead).
+echo "mjcf/workcells/low_beam.xml:"
+derive mjcf/workcells/low_beam.xml pick pick

@@ -137,12 +137,16 @@ nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Param
     json collapsed = json::array();
     for (size_t i = 0; i < w.collapsed.size(); ++i)
       if (w.collapsed[i]) collapsed.push_back(scene.joints()[i].name);
-    // Per joint: how much the safety stage took off the guide interval [rad or m].
-    json shrunk = json::object();
+    // Per joint: how much the safety stage took off the guide interval, and how much its growth
+    // added beyond it [rad or m].
+    json shrunk = json::object(), grown = json::object();
     for (Eigen::Index i = 0; i < w.lower.size(); ++i) {
       const auto [below, above] = w.shrunk_by(i);
+      const std::string& name = scene.joints()[static_cast<size_t>(i)].name;
       if (below > 0 || above > 0)
-        shrunk[scene.joints()[static_cast<size_t>(i)].name] = {{"lower_by", below}, {"upper_by", above}};
+        shrunk[name] = {{"lower_by", std::max(0.0, below)}, {"upper_by", std::max(0.0, above)}};
+      if (below < 0 || above < 0)
+        grown[name] = {{"lower_by", std::max(0.0, -below)}, {"upper_by", std::max(0.0, -above)}};
     }
     wps.push_back({{"t", timing.segment_start[wi]},
                    {"s", static_cast<double>(wi)},
@@ -151,6 +155,7 @@ nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Param
                    {"upper", detail::to_json_array(w.upper)},
                    {"collapsed", collapsed},
                    {"shrunk", shrunk},
+                   {"grown", grown},
                    {"guide_lower", detail::to_json_array(w.guide_lower)},
                    {"guide_upper", detail::to_json_array(w.guide_upper)},
                    {"nominal_in_volume", w.nominal_in_volume},
@@ -175,6 +180,45 @@ nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Param
                       {"safety", run.ms_safety},         {"total", run.ms_total()}};
   out["params"] = to_json(params);
   return out;
+}
+
+nlohmann::json room_json(const Scene& scene, const RoomReport& room, const RoomOptions& options) {
+  using nlohmann::json;
+  auto number = [](double v) { return std::isnan(v) ? json(nullptr) : json(v); };
+  json shares = json::object();
+  for (int i = 0; i < scene.dof(); ++i)
+    shares[scene.joints()[static_cast<size_t>(i)].name] = number(room.joint_share[i]);
+  json wps = json::array();
+  for (const WaypointRoom& w : room.waypoints) {
+    json lower = json::array(), upper = json::array(), share = json::array();
+    for (size_t i = 0; i < w.free.size(); ++i) {
+      lower.push_back(w.free[i].lower);
+      upper.push_back(w.free[i].upper);
+      share.push_back(number(w.share[static_cast<Eigen::Index>(i)]));
+    }
+    wps.push_back({{"waypoint", w.waypoint},
+                   {"free_lower", lower},
+                   {"free_upper", upper},
+                   {"share", share},
+                   {"tool_translation", w.tool_translation},
+                   {"tool_rotation", w.tool_rotation}});
+  }
+  return {{"measure",
+           "share: per joint and waypoint, (upper - lower) over the width of the one-joint free range "
+           "[free_lower, free_upper] (the joint alone moved from its nominal value, the others at theirs, "
+           "until the robot touches an obstacle or itself, within the joint's limits); joint_share: its "
+           "mean over the waypoints; mean_share: the mean over the joints. tool_translation [m] and "
+           "tool_rotation [rad]: the largest found over the box's corners and random configurations "
+           "(sampled: a lower bound of the largest). A path of more than max_waypoints waypoints is measured "
+           "at max_waypoints of them, evenly spaced (each entry's waypoint is its index)"},
+          {"free_range_tolerance", options.tolerance},
+          {"tool_samples", options.tool_samples},
+          {"max_waypoints", options.max_waypoints},
+          {"seed", options.seed},
+          {"joint_share", shares},
+          {"mean_share", number(room.mean_share)},
+          {"waypoints", wps},
+          {"ms", room.ms}};
 }
 
 namespace {

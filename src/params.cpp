@@ -58,6 +58,8 @@ void for_each_field(P& p, F&& f) {
   f("safety", "epsilon", p.safety.epsilon);
   f("safety", "delta", p.safety.delta);
   f("safety", "seed", p.safety.seed);
+  f("safety", "grow", p.safety.grow);
+  f("safety", "max_half_width", p.safety.max_half_width);
 }
 
 const char* distance_name(DistanceMode m) { return m == DistanceMode::k3d ? "3d" : "plane"; }
@@ -144,6 +146,21 @@ void read_value(const json& v, const std::string& key, const std::string& source
   wrong_type(source, key, "\"none\", \"sampled\" or \"certified\"", v);
 }
 
+void read_value(const json& v, const std::string& key, const std::string& source, std::string& out) {
+  if (!v.is_string()) wrong_type(source, key, "a string", v);
+  out = v.get<std::string>();
+}
+
+void read_value(const json& v, const std::string& key, const std::string& source,
+                std::map<std::string, double>& out) {
+  if (!v.is_object()) wrong_type(source, key, "an object of joint names and numbers", v);
+  out.clear();
+  for (const auto& [name, value] : v.items()) {
+    if (!value.is_number()) wrong_type(source, key + "." + name, "a number", value);
+    out[name] = value.get<double>();
+  }
+}
+
 std::string join(const std::set<std::string>& names) {
   std::string s;
   for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
@@ -215,6 +232,11 @@ void Params::validate() const {
   require_between("safety.max_leaves", safety.max_leaves, 1, 100000000);
   require_between("safety.epsilon", safety.epsilon, 1e-9, 0.5);
   require_between("safety.delta", safety.delta, 1e-12, 0.5);
+  if (safety.grow.empty()) throw InputError("parameter 'safety.grow' is empty: give all, none or joint names");
+  for (const auto& [name, half] : safety.max_half_width)
+    if (!(half >= 0 && half <= kMaxLength))
+      throw InputError("parameter 'safety.max_half_width." + name + "' = " + format_number(half) +
+                       " must be between 0 and " + value_text(kMaxLength));
 }
 
 const char* safety_mode_name(SafetyMode mode) {

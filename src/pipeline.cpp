@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "grow.hpp"
 #include "leeway/categorize.hpp"
 #include "leeway/error.hpp"
 
@@ -16,6 +17,8 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 
 void validate_for_scene(const Params& params, const Scene& scene) {
   params.validate();
+  grow_mask(scene, params.safety);
+  half_width_caps(scene, params.safety);
   const auto kinds = bound_kinds(scene);
   for (size_t i = 0; i < kinds.size(); ++i) {
     const RobotJoint& j = scene.joints()[i];

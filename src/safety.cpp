@@ -6,6 +6,7 @@
 #include <memory>
 #include <random>
 
+#include "grow.hpp"
 #include "leeway/error.hpp"
 #include "leeway/kinematics.hpp"
 #include "parallel.hpp"
@@ -324,6 +325,17 @@ SegmentSafety sample_segment(RobotState& state, Extents& e, size_t a, size_t b, 
   return s;
 }
 
+// The certifier's options for a segment: each segment counts its leaves from zero (its own
+// CertifyStats) up to segment_leaf_budget.
+CertifyOptions certify_options(const SafetyParams& params, CertifyBound bound) {
+  CertifyOptions options;
+  options.margin = params.margin;
+  options.max_leaves = params.max_leaves;
+  options.bound = bound;
+  options.leaf_limit = kSegmentLeafBudgetFactor * static_cast<long>(params.max_leaves);
+  return options;
+}
+
 }  // namespace
 
 long segment_leaf_budget(const SafetyParams& params) {
@@ -348,13 +360,12 @@ SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, 
   }
   Extents e(bounds);
   const size_t segments = std::max<size_t>(1, bounds.size() - 1);
+  // A dense path: at least half its segments short.
+  size_t short_count = 0;
+  for (size_t s = 0; s + 1 < bounds.size(); ++s) short_count += is_short(e, s, s + 1) ? 1 : 0;
+  const bool dense = 2 * short_count >= segments && segments > 1;
   if (params.mode == SafetyMode::kCertified) {
-    CertifyOptions options;
-    options.margin = params.margin;
-    options.max_leaves = params.max_leaves;
-    options.bound = bound;
-    // Each segment counts its leaves from zero (certify_segment's own CertifyStats).
-    options.leaf_limit = segment_leaf_budget(params);
+    const CertifyOptions options = certify_options(params, bound);
     const Extents guide(bounds);
     // Segment s writes waypoints s and s + 1 and, regrowing them, reads its neighbours' (s - 1 and
     // s + 2): segments three apart share nothing, so the segments with s % phases == phase run in
@@ -364,9 +375,7 @@ SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, 
     std::vector<CertifyStats> stats(segments);
     // A dense path (at least half its segments short) takes kDensePhases phases: every segment but
     // those of phase 0 then has a settled neighbour to start warm from.
-    size_t short_count = 0;
-    for (size_t s = 0; s + 1 < bounds.size(); ++s) short_count += is_short(guide, s, s + 1) ? 1 : 0;
-    const size_t phases = 2 * short_count >= segments && segments > 1 ? kDensePhases : 3;
+    const size_t phases = dense ? kDensePhases : 3;
     for (size_t phase = 0; phase < phases; ++phase) {
       std::vector<size_t> jobs;
       for (size_t s = phase; s < segments; s += phases) jobs.push_back(s);
@@ -415,6 +424,15 @@ SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, 
       if (e.below[k][i] != original.below[k][i]) bounds[k].lower[i] = bounds[k].q[i] - e.below[k][i];
       if (e.above[k][i] != original.above[k][i]) bounds[k].upper[i] = bounds[k].q[i] + e.above[k][i];
     }
+  // Growth runs on sparse paths: on a dense one it would cost several times the certified mode's
+  // work (docs/algorithm.md, "Growing"). The caps apply to every path.
+  if (params.mode == SafetyMode::kCertified && (!dense || !params.max_half_width.empty()) &&
+      (params.grow != "none" || !params.max_half_width.empty())) {
+    SafetyParams growth = params;
+    if (dense) growth.grow = "none";
+    report.grow = grow_bounds(scene, bounds, report.segments, growth, certify_options(params, bound), threads);
+    report.stats.add(report.grow.stats);
+  }
   report.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return report;
 }

@@ -56,7 +56,8 @@ struct WaypointBounds {
   //! @throws InputError when c's size differs from the bounds'.
   bool contains(const Eigen::VectorXd& c) const;
 
-  //! What the safety stage took off joint i's guide interval [rad or m]: {from below, from above};
+  //! What the safety stage took off joint i's guide interval [rad or m]: {from below, from above}, negative
+  //! on a side its growth widened;
   //! {0, 0} when no guide is recorded (bounds read from a file).
   std::pair<double, double> shrunk_by(Eigen::Index i) const;
 

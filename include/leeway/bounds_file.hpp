@@ -10,6 +10,7 @@
 #include "leeway/bounds_trajectory.hpp"
 #include "leeway/params.hpp"
 #include "leeway/pipeline.hpp"
+#include "leeway/room.hpp"
 #include "leeway/safety.hpp"
 #include "leeway/scene.hpp"
 
@@ -36,6 +37,11 @@ void require_bounds_shape(const nlohmann::json& j, const std::string& path);
 
 //! The bounds file (docs/cli.md): joints, waypoints (q, lower, upper), boxes, max_cells, timing_ms...
 nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Params& params);
+
+//! The room record of a bounds file (docs/algorithm.md, "Room"): what the measure is, per joint the
+//! share of its one-joint free range kept (names as keys), their mean, and per waypoint the free
+//! ranges, the shares and the tool's room. An undefined share is null.
+nlohmann::json room_json(const Scene& scene, const RoomReport& room, const RoomOptions& options);
 
 //! Reads a bounds file written for `scene`: q, lower, upper and collapsed of every waypoint (the
 //! guide bounds and checks are not read). A file without "format" is accepted (older files).

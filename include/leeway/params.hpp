@@ -5,6 +5,7 @@
 //! leeway's choices. docs/algorithm.md documents each and where it comes from.
 
 #include <cstdint>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -111,6 +112,12 @@ struct SafetyParams {
   double epsilon = 1e-4;   //!< sampled mode: tolerated collision share
   double delta = 0.05;     //!< sampled mode: the test passes a worse region with probability < delta
   std::uint64_t seed = 1;  //!< sampled mode: RNG seed
+  //! Certified mode: the joints whose intervals grow beyond the guide once every segment is
+  //! certified (docs/algorithm.md, "Growing"): "all", "none", or joint names separated by commas.
+  std::string grow = "all";
+  //! Certified mode: the largest half-width growth may give a joint, by joint name [rad or m];
+  //! joints not named are limited by their free range and joint limits only.
+  std::map<std::string, double> max_half_width;
 };
 
 //! All parameters.

@@ -38,6 +38,14 @@ constexpr long kSegmentLeafBudgetFactor = 128;
 //! The leaf budget of one segment: kSegmentLeafBudgetFactor * max_leaves.
 long segment_leaf_budget(const SafetyParams& params);
 
+//! What the growth beyond the guide did (certified mode, params.grow not "none").
+struct GrowReport {
+  bool ran = false;    //!< growth ran (certified mode, some joint to grow)
+  int grown = 0;       //!< intervals (waypoint x joint) now wider than the guide's on some side
+  CertifyStats stats;  //!< certificate work of the growth (in SafetyReport::stats too)
+  double ms = 0;       //!< wall time [ms] (in SafetyReport::ms too)
+};
+
 //! What the safety stage did.
 struct SafetyReport {
   SafetyMode mode = SafetyMode::kNone;
@@ -46,6 +54,7 @@ struct SafetyReport {
   CertifyStats stats;            //!< certificate work, all segments
   long samples_per_segment = 0;  //!< sampled mode: N = ceil(ln(1/delta) / epsilon)
   double ms = 0;                 //!< wall time of the stage [ms]
+  GrowReport grow;               //!< certified mode: the growth beyond the guide
 };
 
 //! Samples one sampling round needs: N = ceil(ln(1/delta) / epsilon). Zero collisions in N uniform

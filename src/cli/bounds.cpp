@@ -1,8 +1,10 @@
 #include "cli/bounds.hpp"
 
+#include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <sstream>
 #include <utility>
 
@@ -15,20 +17,59 @@
 #include "leeway/path_check.hpp"
 #include "leeway/pipeline.hpp"
 #include "leeway/planner.hpp"
+#include "leeway/room.hpp"
 
 namespace leeway::cli {
 namespace {
 
 using nlohmann::json;
 
-// "  (safety: lower +0.0312)": what the safety stage took off joint i's guide interval.
+// "  (safety shrank it: lower +0.0312, upper -0.0000)": what the safety stage took off joint i's guide
+// interval, and what its growth added beyond it.
 std::string shrink_note(const WaypointBounds& w, int i) {
   const auto [below, above] = w.shrunk_by(i);
-  if (!(below > 0) && !(above > 0)) return "";
   std::ostringstream o;
-  o << std::fixed << std::setprecision(4) << "  (safety shrank it: lower +" << below << ", upper -" << above
-    << ")";
+  o << std::fixed << std::setprecision(4);
+  if (below > 0 || above > 0)
+    o << "  (safety shrank it: lower +" << std::max(0.0, below) << ", upper -" << std::max(0.0, above) << ")";
+  if (below < 0 || above < 0)
+    o << "  (grown beyond the guide: lower -" << std::max(0.0, -below) << ", upper +" << std::max(0.0, -above)
+      << ")";
   return o.str();
+}
+
+// Two lines on the room: each joint's kept share of its one-joint free range and their mean; the
+// tool's room at the start and the goal, and the largest along the path.
+void print_room(const Scene& scene, const RoomReport& room, const RoomOptions& options) {
+  std::ostringstream o;
+  o << std::fixed << std::setprecision(1)
+    << "room: share of each joint's one-joint free range kept [%], mean over "
+    << (room.waypoints.size() < static_cast<size_t>(room.waypoints.back().waypoint + 1)
+            ? std::to_string(room.waypoints.size()) + " evenly spaced waypoints:"
+            : std::string("the waypoints:"));
+  for (int i = 0; i < scene.dof(); ++i) {
+    o << (i ? ", " : " ") << scene.joints()[static_cast<size_t>(i)].name << " ";
+    if (std::isnan(room.joint_share[i]))
+      o << "-";
+    else
+      o << 100 * room.joint_share[i];
+  }
+  o << "; mean " << 100 * room.mean_share << "\n";
+  size_t widest = 0;
+  for (size_t k = 0; k < room.waypoints.size(); ++k)
+    if (room.waypoints[k].tool_translation > room.waypoints[widest].tool_translation) widest = k;
+  o << std::setprecision(3) << "tool's room (largest over the corners and " << options.tool_samples
+    << " samples of each box, a lower bound):";
+  auto at = [&](const std::string& what, size_t k) {
+    o << " " << what << " " << room.waypoints[k].tool_translation << " m, " << room.waypoints[k].tool_rotation
+      << " rad";
+  };
+  at("start", 0);
+  o << ";";
+  at("goal", room.waypoints.size() - 1);
+  o << ";";
+  at("most (waypoint " + std::to_string(room.waypoints[widest].waypoint) + ")", widest);
+  std::cout << o.str() << "\n";
 }
 
 // One line on the safety stage: mode, outcome, work.
@@ -59,6 +100,12 @@ void print_safety(const SafetyReport& r, const SafetyParams& params) {
             << kSegmentLeafBudgetFactor << " x safety.max_leaves) ran out on " << exhausted << " of " << n
             << " segments (NOT CERTIFIED where it ran out before the proof, narrower bounds where it ran "
                "out while regrowing)\n";
+      if (r.grow.ran)
+        std::cout << "safety: grew " << r.grow.grown
+                  << " intervals beyond the guide, every growth proven (" << r.grow.stats.leaves << " of the leaves, "
+                  << std::fixed << std::setprecision(1) << r.grow.ms << " ms)\n";
+      else if (params.grow != "none" && n > 1 && r.all_passed)
+        std::cout << "safety: no growth beyond the guide on a dense path (docs/algorithm.md, \"Growing\")\n";
       break;
     case SafetyMode::kSampled:
       std::cout << "safety: sampled, " << passed << " of " << n << " segments passed "
@@ -110,6 +157,10 @@ CLI::App* add_bounds(CLI::App& app, BoundsArgs& args) {
   sub->add_flag("--json", args.json, "Print the bounds file to standard output");
   sub->add_flag("--no-plan", args.no_plan,
                 "Exit 1 when the straight path between two keyframes collides instead of planning around it");
+  sub->add_option("--room", args.room,
+                  "Measure the room the bounds keep (on, off; default: on, off with --preset thesis, "
+                  "whose output stays the published method's)")
+      ->check(CLI::IsMember({"on", "off"}));
   sub->final_callback([sub, &args] {
     args.max_cells_given = sub->count("--max-cells") > 0;
     args.waypoints_given = sub->count("--waypoints") > 0;
@@ -246,6 +297,12 @@ int run_bounds(const BoundsArgs& args) {
   const auto run = compute_bounds(scene, world, path, p, args.threads);
   json out = bounds_json(scene, run, p);
   out["nominal_path"] = nominal;
+  const RoomOptions room_options;
+  std::optional<RoomReport> room;
+  if (args.room == "on" || (args.room.empty() && args.preset != "thesis")) {
+    room = measure_room(scene, run.bounds, room_options, args.threads);
+    out["room"] = room_json(scene, *room, room_options);
+  }
   // The exports first: the MJB compiles the model and may fail; then nothing else is written.
   std::string mjcf, mjb;
   if (!args.export_mjcf.empty()) mjcf = volume_mjcf(scene.source(), run.volume.boxes, args.export_mjcf);
@@ -272,6 +329,7 @@ int run_bounds(const BoundsArgs& args) {
                 << shrink_note(run.bounds[w], i) << "\n";
   }
   print_safety(run.safety, p.safety);
+  if (room) print_room(scene, *room, room_options);
   std::cout << std::setprecision(1) << "time [ms]: categorize " << run.ms_categorize << ", volume "
             << run.ms_volume << ", inject " << run.ms_inject << ", bounds " << run.ms_bounds << ", safety "
             << run.ms_safety << ", total " << run.ms_total() << "\n";

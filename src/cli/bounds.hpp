@@ -29,6 +29,7 @@ struct BoundsArgs {
   int threads = default_threads();   //!< worker threads
   bool json = false;                 //!< print the bounds file instead of text
   bool no_plan = false;              //!< exit 1 on a colliding straight path instead of planning
+  std::string room;                  //!< measure the room: "on", "off"; empty: the preset's default
   PlanOptions plan;                  //!< planner seed and time limit
 };
 

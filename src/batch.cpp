@@ -431,7 +431,7 @@ json run_scenario(const json& resolved, int threads) {
     const CfResult cf = confidence_factor(scene, run.bounds, p.cf, threads);
     timing["cf_s"] = seconds_since(c0);
     CaseEval widths;
-    width_stats(scene, run.bounds, 0.0, widths);
+    width_stats(scene, p.bounds, run.bounds, 0.0, widths);
     int passed = 0;
     for (const auto& seg : run.safety.segments) passed += seg.passed ? 1 : 0;
     measured["max_cells"] = p.height_map.max_cells;

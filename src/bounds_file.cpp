@@ -110,7 +110,7 @@ nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Param
   out["cell"] = scene.source();
   out["joints"] = scene.joint_names();
   json kinds = json::array();
-  for (BoundKind k : bound_kinds(scene))
+  for (BoundKind k : bound_kinds(scene, params.bounds))
     kinds.push_back(k == BoundKind::kBisected ? "bisected"
                     : k == BoundKind::kFixed  ? "fixed"
                                               : "linear_axis");

@@ -8,6 +8,8 @@
 #include <set>
 #include <string>
 #include <type_traits>
+#include <utility>
+#include <vector>
 
 #include "json_io.hpp"
 #include "leeway/error.hpp"
@@ -49,6 +51,8 @@ void for_each_field(P& p, F&& f) {
   f("bounds", "wrist_half_width", p.bounds.wrist_half_width);
   f("bounds", "linear_axis_tolerance", p.bounds.linear_axis_tolerance);
   f("bounds", "self_collision", p.bounds.self_collision);
+  f("bounds", "bisect", p.bounds.bisect);
+  f("bounds", "half_width", p.bounds.half_width);
   f("cf", "windows", p.cf.windows);
   f("cf", "samples", p.cf.samples);
   f("cf", "seed", p.cf.seed);
@@ -144,6 +148,25 @@ void read_value(const json& v, const std::string& key, const std::string& source
   wrong_type(source, key, "\"none\", \"sampled\" or \"certified\"", v);
 }
 
+void read_value(const json& v, const std::string& key, const std::string& source,
+                std::vector<std::string>& out) {
+  if (!v.is_array()) wrong_type(source, key, "a list of joint names", v);
+  std::vector<std::string> names;
+  for (const json& name : v) {
+    if (!name.is_string()) wrong_type(source, key, "a list of joint names", v);
+    names.push_back(name.get<std::string>());
+  }
+  out = std::move(names);
+}
+
+void read_value(const json& v, const std::string& key, const std::string& source,
+                std::map<std::string, double>& out) {
+  if (!v.is_object()) wrong_type(source, key, "an object of joint names and half-widths", v);
+  std::map<std::string, double> widths;
+  for (const auto& [name, width] : v.items()) read_value(width, key + "." + name, source, widths[name]);
+  out = std::move(widths);
+}
+
 std::string join(const std::set<std::string>& names) {
   std::string s;
   for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
@@ -205,6 +228,25 @@ void Params::validate() const {
   require_between("bounds.min_half_width", bounds.min_half_width, 0.0, kMaxLength);
   require_between("bounds.wrist_half_width", bounds.wrist_half_width, 0.0, kMaxLength);
   require_between("bounds.linear_axis_tolerance", bounds.linear_axis_tolerance, 0.0, 1.0);
+  // The joint names are checked against the robot by validate_for_scene; here what needs no robot.
+  if (static_cast<int>(bounds.bisect.size()) > kMaxBisected)
+    throw InputError("parameter 'bounds.bisect' names " + std::to_string(bounds.bisect.size()) +
+                     " joints; at most " + std::to_string(kMaxBisected) +
+                     " can be bisected (the sixth takes 64 Algorithm-2 runs per waypoint, each further one "
+                     "doubles them)");
+  for (size_t i = 0; i < bounds.bisect.size(); ++i) {
+    const std::string& name = bounds.bisect[i];
+    if (name.empty()) throw InputError("parameter 'bounds.bisect' holds an empty joint name");
+    for (size_t k = 0; k < i; ++k)
+      if (bounds.bisect[k] == name)
+        throw InputError("parameter 'bounds.bisect' names joint '" + name + "' twice");
+  }
+  for (const auto& [name, width] : bounds.half_width) {
+    if (name.empty()) throw InputError("parameter 'bounds.half_width' holds an empty joint name");
+    const std::string key = "bounds.half_width." + name;
+    if (!std::isfinite(width)) throw InputError(describe(key.c_str(), width) + " must be a finite number");
+    require_between(key.c_str(), width, 0.0, kMaxLength);
+  }
   require_between("cf.windows", cf.windows, 1, std::numeric_limits<int>::max());
   require_between("cf.samples", cf.samples, 1, std::numeric_limits<int>::max());
   if (safety.mode != SafetyMode::kNone && safety.mode != SafetyMode::kSampled &&

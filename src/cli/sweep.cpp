@@ -143,7 +143,7 @@ int run_sweep(const SweepArgs& args) {
     const auto r = confidence_factor(scene, run.bounds, cf, args.threads);
     // Collapsed intervals and the mean width of the bisected joints' intervals.
     CaseEval stats;
-    width_stats(scene, run.bounds, 0.0, stats);
+    width_stats(scene, p.bounds, run.bounds, 0.0, stats);
     const int collapsed = stats.collapsed, bisected = stats.bisected;
     const double width = stats.mean_width;
     md << std::fixed << "| " << c << " | " << run.volume.boxes.size() << " | " << std::setprecision(1)

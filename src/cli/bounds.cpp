@@ -100,6 +100,7 @@ CLI::App* add_bounds(CLI::App& app, BoundsArgs& args) {
   sub->add_option("--params", args.params, "Parameter file (JSON; see leeway params)")
       ->check(file_name_check());
   add_preset_options(sub, args.preset, args.safety);
+  add_joint_bounds_options(sub, args.joints);
   sub->add_option("--out", args.out, "Write the bounds file here (JSON)")->check(file_name_check());
   sub->add_option("--export-mjcf", args.export_mjcf,
                   "Write the cell with its volume as MJCF (named visual-only box geoms) for mujoco-simulate")
@@ -127,6 +128,7 @@ int run_bounds(const BoundsArgs& args) {
   Params p = load_params(scene, args.preset, args.params, args.safety);
   if (args.max_cells_given) p.height_map.max_cells = args.max_cells;
   p.validate();
+  apply_joint_bounds_options(scene, args.joints, p);
   require_threads(args.threads);
   // No output may replace a file the run reads: the cell, its includes and meshes, the parameter
   // and path files.

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <regex>
 #include <thread>
 #include <tuple>
@@ -17,6 +18,7 @@
 #include "leeway/cell_defaults.hpp"
 #include "leeway/endpoints.hpp"
 #include "leeway/file_io.hpp"
+#include "leeway/pipeline.hpp"
 #include "leeway/planner.hpp"
 
 namespace leeway::cli {
@@ -52,6 +54,71 @@ void add_preset_options(CLI::App* sub, std::string& preset, std::string& safety)
                   "certified (every interval proven free of the obstacles), sampled (an epsilon-delta\n"
                   "sampling test) or none (the thesis's bounds as they are); default: the preset's")
       ->check(non_empty_check("certified, sampled or none"));
+}
+
+void add_joint_bounds_options(CLI::App* sub, JointBoundsOptions& options) {
+  sub->add_option("--bisect", options.bisect,
+                  "Joints Algorithm 3 bisects, e.g. j1,j2,j4 (hinge joints, at most 6, bounded base to\n"
+                  "tip); default: the parameters' bounds.bisect, or the first three hinge joints")
+      ->check(non_empty_check("joint names, e.g. j1,j2,j4"));
+  sub->add_option("--half-width", options.half_width,
+                  "Fixed half-widths of joints that are not bisected [rad or m], e.g. j5=0.3,j6=0.1;\n"
+                  "default: bounds.wrist_half_width (hinge), bounds.linear_axis_tolerance (slide)")
+      ->check(non_empty_check("NAME=VALUE pairs, e.g. j5=0.3,j6=0.1"));
+}
+
+namespace {
+
+// "a,b,c" -> {"a", "b", "c"}; an empty item ("a,,b", "a,") is refused.
+std::vector<std::string> split_list(const std::string& text, const std::string& flag) {
+  std::vector<std::string> items;
+  size_t start = 0;
+  while (true) {
+    const size_t comma = text.find(',', start);
+    const std::string item =
+        text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    if (item.empty())
+      throw InputError(flag + " '" + text + "': an empty item (give comma-separated items without spaces)");
+    items.push_back(item);
+    if (comma == std::string::npos) return items;
+    start = comma + 1;
+  }
+}
+
+}  // namespace
+
+void apply_joint_bounds_options(const Scene& scene, const JointBoundsOptions& options, Params& p) {
+  if (options.bisect.empty() && options.half_width.empty()) return;
+  // The preset, the cell's and the file's parameters alone first, so that what is refused below
+  // comes from the flags.
+  validate_for_scene(p, scene);
+  std::string given;
+  if (!options.bisect.empty()) {
+    p.bounds.bisect = split_list(options.bisect, "--bisect");
+    given = "--bisect " + options.bisect;
+  }
+  if (!options.half_width.empty()) {
+    std::map<std::string, double> widths;
+    for (const std::string& item : split_list(options.half_width, "--half-width")) {
+      const size_t eq = item.find('=');
+      const std::string name = item.substr(0, eq);
+      const std::string value = eq == std::string::npos ? "" : item.substr(eq + 1);
+      char* end = nullptr;
+      const double v = std::strtod(value.c_str(), &end);
+      if (eq == std::string::npos || name.empty() || value.empty() || *end != '\0')
+        throw InputError("--half-width '" + item +
+                         "' must be NAME=VALUE, a joint and its half-width [rad or m]");
+      if (!widths.emplace(name, v).second)
+        throw InputError("--half-width " + options.half_width + ": joint '" + name + "' is given twice");
+    }
+    p.bounds.half_width = std::move(widths);
+    given += (given.empty() ? "" : " / ") + std::string("--half-width ") + options.half_width;
+  }
+  try {
+    validate_for_scene(p, scene);
+  } catch (const InputError& e) {
+    throw InputError(given + ": " + e.what());
+  }
 }
 
 Eigen::VectorXd configuration(const Scene& scene, const std::string& q, const std::string& key,

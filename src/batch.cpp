@@ -205,7 +205,8 @@ Params scenario_params(const Scene& scene, const json& s) {
     p.cf.seed = s["cf"].value("seed", p.cf.seed);
     p.cf.self = s["cf"].value("self", p.cf.self);
   }
-  p.validate();
+  // Against the robot too (bounds.bisect and bounds.half_width name its joints), before any run.
+  validate_for_scene(p, scene);
   return p;
 }
 

@@ -321,6 +321,13 @@ TEST_F(BatchTest, ABadSuiteIsExitTwoBeforeAnyScenarioRunsAndWritesNothing) {
       {{passing(), with("path", "missing.json")}, "field 'path' excludes 'from' and 'to'"},
       {{passing(), with("params", {{"volume", {{"h_max", -1}}}})}, "scenario 2 'second': field 'params': "},
       {{passing(), with("params", 7)}, "field 'params' must be a parameter file's name or an object"},
+      // Joint names are checked against the scenario's robot before any scenario runs.
+      {{passing(), with("params", {{"bounds", {{"bisect", json::array({"elbow"})}}}})},
+       "scenario 2 'second': field 'params': " + path("cell.xml") +
+           ": parameter 'bounds.bisect' names joint 'elbow', which the robot does not have (joints: j1)"},
+      {{passing(), with("params", {{"bounds", {{"half_width", {{"j1", 0.1}}}}}})},
+       "scenario 2 'second': field 'params': " + path("cell.xml") +
+           ": parameter 'bounds.half_width.j1' = 0.1: joint 'j1' is bisected"},
       {{passing(), with("simulate", {{"human", "shove"}})}, "field 'simulate.human' 'shove' must be one of"},
       {{passing(), with("simulate", {{"human", "push-toward"}})}, "field 'simulate.target' is missing"},
       {{passing(), with("simulate", {{"amplitude", 1e6}})}, "field 'simulate.amplitude' 1000000.0 must be"},

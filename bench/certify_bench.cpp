@@ -223,7 +223,7 @@ int main(int argc, char** argv) {
       p.safety.mode = leeway::SafetyMode::kNone;
       leeway::VolumeModel world(scene,
                                 p.height_map.max_cells + static_cast<int>(scene.obstacle_geoms().size()));
-      const auto bound_kinds = leeway::bound_kinds(scene);
+      const auto bound_kinds = leeway::bound_kinds(scene, p.bounds);
       std::vector<bool> bisected, all(static_cast<size_t>(scene.dof()), true);
       for (const auto k : bound_kinds) bisected.push_back(k == leeway::BoundKind::kBisected);
       for (const auto& [from, to] : paths) {

@@ -22,6 +22,7 @@
 #include "leeway/path_check.hpp"
 #include "leeway/pipeline.hpp"
 #include "leeway/planner.hpp"
+#include "leeway/room.hpp"
 #include "leeway/simulate.hpp"
 #include "leeway/tuning.hpp"
 #include "mjcf_text.hpp"
@@ -164,9 +165,14 @@ void check_fields(const Fields& f, const json& s, bool is_defaults) {
       f.fail("simulate.target", "is missing: push-toward needs an obstacle's name or \"nearest\"");
   }
   if (s.contains("expect")) {
-    f.known_keys(
-        s["expect"], "expect",
-        {"check", "cf_min", "certified", "mean_width_min", "self_collisions_max", "time_max", "simulate"});
+    f.known_keys(s["expect"], "expect",
+                 {"check", "cf_min", "certified", "mean_width_min", "self_collisions_max", "time_max",
+                  "simulate", "room"});
+    if (s["expect"].contains("room")) {
+      f.known_keys(s["expect"]["room"], "expect.room", {"mean_share_min", "tool_translation_min"});
+      f.number("expect.room.mean_share_min", 0, 1, "a fraction from 0 to 1");
+      f.number("expect.room.tool_translation_min", 0, 100, "a distance from 0 to 100 m");
+    }
     if (s["expect"].contains("simulate")) {
       f.known_keys(s["expect"]["simulate"], "expect.simulate", {"contacts", "min_distance"});
       f.whole("expect.simulate.contacts", 0, std::numeric_limits<long long>::max());
@@ -205,7 +211,8 @@ Params scenario_params(const Scene& scene, const json& s) {
     p.cf.seed = s["cf"].value("seed", p.cf.seed);
     p.cf.self = s["cf"].value("self", p.cf.self);
   }
-  p.validate();
+  // Against the robot too (bounds.bisect and bounds.half_width name its joints), before any run.
+  validate_for_scene(p, scene);
   return p;
 }
 
@@ -348,6 +355,8 @@ Suite read_suite(const std::string& file) {
     if (const auto c = f.whole("expect.simulate.contacts", 0, std::numeric_limits<long long>::max()))
       sc.expect.simulate_contacts_max = static_cast<long>(*c);
     sc.expect.simulate_min_distance = f.number("expect.simulate.min_distance", 0, 100, "");
+    sc.expect.room_mean_share_min = f.number("expect.room.mean_share_min", 0, 1, "");
+    sc.expect.room_tool_translation_min = f.number("expect.room.tool_translation_min", 0, 100, "");
     suite.scenarios.push_back(std::move(sc));
   }
   return suite;
@@ -431,7 +440,7 @@ json run_scenario(const json& resolved, int threads) {
     const CfResult cf = confidence_factor(scene, run.bounds, p.cf, threads);
     timing["cf_s"] = seconds_since(c0);
     CaseEval widths;
-    width_stats(scene, run.bounds, 0.0, widths);
+    width_stats(scene, p.bounds, run.bounds, 0.0, widths);
     int passed = 0;
     for (const auto& seg : run.safety.segments) passed += seg.passed ? 1 : 0;
     measured["max_cells"] = p.height_map.max_cells;
@@ -451,6 +460,11 @@ json run_scenario(const json& resolved, int threads) {
     measured["mean_width"] = widths.mean_width;
     measured["bisected"] = widths.bisected;
     measured["collapsed"] = widths.collapsed;
+    // The room the bounds keep (docs/algorithm.md, "Room").
+    const RoomReport room = measure_room(scene, run.bounds, RoomOptions{}, threads);
+    measured["room_mean_share"] = std::isnan(room.mean_share) ? json(nullptr) : json(room.mean_share);
+    measured["room_goal_tool_translation"] = room.waypoints.back().tool_translation;
+    measured["room_goal_tool_rotation"] = room.waypoints.back().tool_rotation;
     // The closed loop (docs/simulate.md), when the scenario asks for it or expects its outcome.
     if (s.contains("simulate") || (s.contains("expect") && s["expect"].contains("simulate"))) {
       const json sim = s.value("simulate", json::object());
@@ -540,6 +554,13 @@ void judge(const Scenario& scenario, json& result) {
     add("simulate_min_distance",
         "simulated min distance >= " + format_number(*x.simulate_min_distance) + " m",
         *x.simulate_min_distance, "simulate_min_distance", 1);
+  if (x.room_mean_share_min)
+    add("room_mean_share_min", "room: mean kept share >= " + format_number(*x.room_mean_share_min),
+        *x.room_mean_share_min, "room_mean_share", 1);
+  if (x.room_tool_translation_min)
+    add("room_tool_translation_min",
+        "room: the tool's translation at the goal >= " + format_number(*x.room_tool_translation_min) + " m",
+        *x.room_tool_translation_min, "room_goal_tool_translation", 1);
   result["expectations"] = list;
   result["passed"] = all;
   if (x.time_max) {

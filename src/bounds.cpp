@@ -108,16 +108,41 @@ void require_joint_counts(const Scene& scene, const std::vector<WaypointBounds>&
   }
 }
 
-std::vector<BoundKind> bound_kinds(const Scene& scene) {
+std::vector<BoundKind> bound_kinds(const Scene& scene, const BoundsParams& params) {
+  const auto& joints = scene.joints();
   std::vector<BoundKind> kinds;
-  int hinges = 0;
-  for (const auto& j : scene.joints()) {
-    if (j.prismatic)
-      kinds.push_back(BoundKind::kLinear);
-    else
-      kinds.push_back(hinges++ < 3 ? BoundKind::kBisected : BoundKind::kFixed);
+  for (const auto& j : joints) kinds.push_back(j.prismatic ? BoundKind::kLinear : BoundKind::kFixed);
+  if (params.bisect.empty()) {
+    // The thesis's rule (section 3.3.1): the first three hinge joints, the arm without its wrist.
+    int hinges = 0;
+    for (size_t i = 0; i < joints.size(); ++i)
+      if (!joints[i].prismatic && hinges++ < 3) kinds[i] = BoundKind::kBisected;
+    return kinds;
+  }
+  for (const std::string& name : params.bisect) {
+    const auto it =
+        std::find_if(joints.begin(), joints.end(), [&name](const RobotJoint& j) { return j.name == name; });
+    if (it == joints.end()) {
+      std::string known;
+      for (const auto& j : joints) known += (known.empty() ? "" : ", ") + j.name;
+      throw InputError(scene.source() + ": parameter 'bounds.bisect' names joint '" + name +
+                       "', which the robot does not have (joints: " + known + ")");
+    }
+    if (it->prismatic)
+      throw InputError(scene.source() + ": parameter 'bounds.bisect' names slide joint '" + name +
+                       "': only hinge joints are bisected (a slide joint's half-width is "
+                       "'bounds.linear_axis_tolerance' or 'bounds.half_width')");
+    kinds[static_cast<size_t>(it - joints.begin())] = BoundKind::kBisected;
   }
   return kinds;
+}
+
+double fixed_half_width(const Scene& scene, int index, const BoundsParams& params) {
+  const RobotJoint& joint = scene.joints()[static_cast<size_t>(index)];
+  const auto named = params.half_width.find(joint.name);
+  if (named != params.half_width.end()) return named->second;
+  return joint.prismatic ? params.linear_axis_tolerance * (joint.upper - joint.lower)
+                         : params.wrist_half_width;
 }
 
 namespace {
@@ -140,18 +165,15 @@ WaypointBounds bound_waypoint_runs(const Scene& scene, const CollisionFn& collid
   w.lower = q;
   w.upper = q;
   w.collapsed.assign(static_cast<size_t>(n), false);
-  const auto kinds = bound_kinds(scene);
-  std::vector<int> bisected;
+  const auto kinds = bound_kinds(scene, params);
+  std::vector<int> bisected;  // in model order, base to tip
   for (int i = 0; i < n; ++i) {
-    const auto& joint = scene.joints()[static_cast<size_t>(i)];
     if (kinds[static_cast<size_t>(i)] == BoundKind::kBisected) {
       bisected.push_back(i);
     } else {
       // The thesis leaves the wrist arbitrary (section 3.3.1) and gives the linear axis a fixed
       // tolerance (section 4.2.3); both are fixed here, clamped to the limits.
-      const double half = kinds[static_cast<size_t>(i)] == BoundKind::kFixed
-                              ? params.wrist_half_width
-                              : params.linear_axis_tolerance * (joint.upper - joint.lower);
+      const double half = fixed_half_width(scene, i, params);
       w.lower[i] = std::max(lo[i], q[i] - half);
       w.upper[i] = std::min(hi[i], q[i] + half);
     }
@@ -159,10 +181,11 @@ WaypointBounds bound_waypoint_runs(const Scene& scene, const CollisionFn& collid
   ++w.checks;
   w.nominal_in_volume = collides(q);
 
-  // Algorithm 3: j1 at nominal; j2 with j1 at each of its bounds; j3 with every combination of
-  // j1's and j2's bounds. The most restrictive result is kept (highest lower, lowest upper). The
-  // runs of one joint (2, then 4, then 8) are independent: run_all may spread them over threads;
-  // their results are combined in a fixed order, so the bounds do not depend on how.
+  // Algorithm 3: the first bisected joint at nominal; the second with the first at each of its
+  // bounds; each later one with every combination of the earlier ones' bounds (the thesis's j1, j2,
+  // j3). The most restrictive result is kept (highest lower, lowest upper). The runs of one joint
+  // (2, then 4, 8, ...) are independent: run_all may spread them over threads; their results are
+  // combined in a fixed order, so the bounds do not depend on how.
   std::vector<Eigen::VectorXd> bases = {q};
   for (int j : bisected) {
     const int runs = 2 * static_cast<int>(bases.size());

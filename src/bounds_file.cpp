@@ -92,6 +92,11 @@ nlohmann::json safety_json(const Scene& scene, const SafetyReport& report, const
     out["pairs"] = {{"link_obstacle", scene.link_geoms().size() * scene.obstacle_geoms().size()},
                     {"self", scene.self_pairs().size()},
                     {"excluded", excluded}};
+    // Growth beyond the guide (docs/algorithm.md, "Growing beyond the guide"); its leaves are in
+    // `leaves` above too.
+    out["grow"] = {
+        {"joints", params.grow},      {"max_half_width", params.max_half_width}, {"ran", report.grow.ran},
+        {"grown", report.grow.grown}, {"leaves", report.grow.stats.leaves},      {"ms", report.grow.ms}};
   } else if (report.mode == SafetyMode::kSampled) {
     out["passed"] = report.all_passed;
     out["epsilon"] = params.epsilon;
@@ -110,7 +115,7 @@ nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Param
   out["cell"] = scene.source();
   out["joints"] = scene.joint_names();
   json kinds = json::array();
-  for (BoundKind k : bound_kinds(scene))
+  for (BoundKind k : bound_kinds(scene, params.bounds))
     kinds.push_back(k == BoundKind::kBisected ? "bisected"
                     : k == BoundKind::kFixed  ? "fixed"
                                               : "linear_axis");
@@ -148,18 +153,20 @@ nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Param
       if (below < 0 || above < 0)
         grown[name] = {{"lower_by", std::max(0.0, -below)}, {"upper_by", std::max(0.0, -above)}};
     }
-    wps.push_back({{"t", timing.segment_start[wi]},
-                   {"s", static_cast<double>(wi)},
-                   {"q", detail::to_json_array(w.q)},
-                   {"lower", detail::to_json_array(w.lower)},
-                   {"upper", detail::to_json_array(w.upper)},
-                   {"collapsed", collapsed},
-                   {"shrunk", shrunk},
-                   {"grown", grown},
-                   {"guide_lower", detail::to_json_array(w.guide_lower)},
-                   {"guide_upper", detail::to_json_array(w.guide_upper)},
-                   {"nominal_in_volume", w.nominal_in_volume},
-                   {"checks", w.checks}});
+    json wp = {{"t", timing.segment_start[wi]},
+               {"s", static_cast<double>(wi)},
+               {"q", detail::to_json_array(w.q)},
+               {"lower", detail::to_json_array(w.lower)},
+               {"upper", detail::to_json_array(w.upper)},
+               {"collapsed", collapsed},
+               {"shrunk", shrunk},
+               {"guide_lower", detail::to_json_array(w.guide_lower)},
+               {"guide_upper", detail::to_json_array(w.guide_upper)},
+               {"nominal_in_volume", w.nominal_in_volume},
+               {"checks", w.checks}};
+    // Only the certified mode grows intervals.
+    if (run.safety.mode == SafetyMode::kCertified) wp["grown"] = grown;
+    wps.push_back(wp);
   }
   out["waypoints"] = wps;
   out["boxes"] = run.volume.boxes.size();

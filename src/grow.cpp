@@ -162,7 +162,8 @@ std::vector<bool> grow_mask(const Scene& scene, const SafetyParams& params) {
     const auto it = std::find(names.begin(), names.end(), name);
     if (it == names.end())
       throw InputError(scene.source() + ": parameter 'safety.grow' = '" + params.grow + "' names joint '" +
-                       name + "', which the robot does not have (give all, none or joint names separated "
+                       name +
+                       "', which the robot does not have (give all, none or joint names separated "
                        "by commas)");
     mask[static_cast<size_t>(it - names.begin())] = true;
   }
@@ -227,8 +228,9 @@ GrowReport grow_bounds(const Scene& scene, std::vector<WaypointBounds>& bounds,
   std::vector<CertifyStats> stats(count);
   const long slab_leaves = params.max_leaves / kSlabBudgetDivisor;
   // Each waypoint may spend on growing as many leaves as its segments took to certify (half of each:
-  // a segment has two ends), so growth at most doubles the certified mode's work.
-  std::vector<long> budget(count, 0);
+  // a segment has two ends), so growth about doubles the certified mode's work at most.
+  // A floor of safety.max_leaves, so that a path certified at once can still grow.
+  std::vector<long> budget(count, static_cast<long>(params.max_leaves));
   for (size_t s = 0; s < segments.size(); ++s) {
     const long half = segments[s].leaves / 2;
     budget[s] += count == 1 ? segments[s].leaves : half;
@@ -251,8 +253,8 @@ GrowReport grow_bounds(const Scene& scene, std::vector<WaypointBounds>& bounds,
           // Tip to base: the guide leaves the wrist least of its room.
           for (int i = n - 1; i >= 0; --i) {
             if (!mask[static_cast<size_t>(i)]) continue;
-            const double tolerance = scene.joints()[static_cast<size_t>(i)].prismatic ? kSlideTolerance
-                                                                                       : kHingeTolerance;
+            const double tolerance =
+                scene.joints()[static_cast<size_t>(i)].prismatic ? kSlideTolerance : kHingeTolerance;
             for (int side = 0; side < 2; ++side) {
               char& stopped = blocked[k][static_cast<size_t>(2 * i + side)];
               if (stopped) continue;

@@ -8,6 +8,8 @@
 #include <set>
 #include <string>
 #include <type_traits>
+#include <utility>
+#include <vector>
 
 #include "json_io.hpp"
 #include "leeway/error.hpp"
@@ -49,6 +51,8 @@ void for_each_field(P& p, F&& f) {
   f("bounds", "wrist_half_width", p.bounds.wrist_half_width);
   f("bounds", "linear_axis_tolerance", p.bounds.linear_axis_tolerance);
   f("bounds", "self_collision", p.bounds.self_collision);
+  f("bounds", "bisect", p.bounds.bisect);
+  f("bounds", "half_width", p.bounds.half_width);
   f("cf", "windows", p.cf.windows);
   f("cf", "samples", p.cf.samples);
   f("cf", "seed", p.cf.seed);
@@ -152,12 +156,31 @@ void read_value(const json& v, const std::string& key, const std::string& source
 }
 
 void read_value(const json& v, const std::string& key, const std::string& source,
+                std::vector<std::string>& out) {
+  if (!v.is_array()) wrong_type(source, key, "a list of joint names", v);
+  std::vector<std::string> names;
+  for (const json& name : v) {
+    if (!name.is_string()) wrong_type(source, key, "a list of joint names", v);
+    names.push_back(name.get<std::string>());
+  }
+  out = std::move(names);
+}
+
+void read_value(const json& v, const std::string& key, const std::string& source,
                 std::map<std::string, double>& out) {
-  if (!v.is_object()) wrong_type(source, key, "an object of joint names and numbers", v);
-  out.clear();
-  for (const auto& [name, value] : v.items()) {
-    if (!value.is_number()) wrong_type(source, key + "." + name, "a number", value);
-    out[name] = value.get<double>();
+  if (!v.is_object()) wrong_type(source, key, "an object of joint names and half-widths", v);
+  std::map<std::string, double> widths;
+  for (const auto& [name, width] : v.items()) read_value(width, key + "." + name, source, widths[name]);
+  out = std::move(widths);
+}
+
+// Per-joint half-widths [rad or m]: named, finite, from 0 to kMaxLength.
+void require_joint_widths(const std::string& key, const std::map<std::string, double>& widths) {
+  for (const auto& [name, width] : widths) {
+    if (name.empty()) throw InputError("parameter '" + key + "' holds an empty joint name");
+    const std::string named = key + "." + name;
+    if (!std::isfinite(width)) throw InputError(describe(named.c_str(), width) + " must be a finite number");
+    require_between(named.c_str(), width, 0.0, kMaxLength);
   }
 }
 
@@ -222,6 +245,20 @@ void Params::validate() const {
   require_between("bounds.min_half_width", bounds.min_half_width, 0.0, kMaxLength);
   require_between("bounds.wrist_half_width", bounds.wrist_half_width, 0.0, kMaxLength);
   require_between("bounds.linear_axis_tolerance", bounds.linear_axis_tolerance, 0.0, 1.0);
+  // The joint names are checked against the robot by validate_for_scene; here what needs no robot.
+  if (static_cast<int>(bounds.bisect.size()) > kMaxBisected)
+    throw InputError("parameter 'bounds.bisect' names " + std::to_string(bounds.bisect.size()) +
+                     " joints; at most " + std::to_string(kMaxBisected) +
+                     " can be bisected (the sixth takes 64 Algorithm-2 runs per waypoint, each further one "
+                     "doubles them)");
+  for (size_t i = 0; i < bounds.bisect.size(); ++i) {
+    const std::string& name = bounds.bisect[i];
+    if (name.empty()) throw InputError("parameter 'bounds.bisect' holds an empty joint name");
+    for (size_t k = 0; k < i; ++k)
+      if (bounds.bisect[k] == name)
+        throw InputError("parameter 'bounds.bisect' names joint '" + name + "' twice");
+  }
+  require_joint_widths("bounds.half_width", bounds.half_width);
   require_between("cf.windows", cf.windows, 1, std::numeric_limits<int>::max());
   require_between("cf.samples", cf.samples, 1, std::numeric_limits<int>::max());
   if (safety.mode != SafetyMode::kNone && safety.mode != SafetyMode::kSampled &&
@@ -232,11 +269,9 @@ void Params::validate() const {
   require_between("safety.max_leaves", safety.max_leaves, 1, 100000000);
   require_between("safety.epsilon", safety.epsilon, 1e-9, 0.5);
   require_between("safety.delta", safety.delta, 1e-12, 0.5);
-  if (safety.grow.empty()) throw InputError("parameter 'safety.grow' is empty: give all, none or joint names");
-  for (const auto& [name, half] : safety.max_half_width)
-    if (!(half >= 0 && half <= kMaxLength))
-      throw InputError("parameter 'safety.max_half_width." + name + "' = " + format_number(half) +
-                       " must be between 0 and " + value_text(kMaxLength));
+  if (safety.grow.empty())
+    throw InputError("parameter 'safety.grow' is empty: give all, none or joint names");
+  require_joint_widths("safety.max_half_width", safety.max_half_width);
 }
 
 const char* safety_mode_name(SafetyMode mode) {

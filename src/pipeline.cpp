@@ -1,6 +1,8 @@
 #include "leeway/pipeline.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <string>
 
 #include "grow.hpp"
 #include "leeway/categorize.hpp"
@@ -19,7 +21,25 @@ void validate_for_scene(const Params& params, const Scene& scene) {
   params.validate();
   grow_mask(scene, params.safety);
   half_width_caps(scene, params.safety);
-  const auto kinds = bound_kinds(scene);
+  // bound_kinds refuses a 'bounds.bisect' that names a joint the robot lacks or a slide joint.
+  const auto kinds = bound_kinds(scene, params.bounds);
+  const auto& joints = scene.joints();
+  for (const auto& [name, width] : params.bounds.half_width) {
+    const auto it = std::find_if(joints.begin(), joints.end(),
+                                 [&name = name](const RobotJoint& j) { return j.name == name; });
+    const std::string named =
+        scene.source() + ": parameter 'bounds.half_width." + name + "' = " + format_number(width);
+    if (it == joints.end()) {
+      std::string known;
+      for (const auto& j : joints) known += (known.empty() ? "" : ", ") + j.name;
+      throw InputError(named + " names a joint the robot does not have (joints: " + known + ")");
+    }
+    if (kinds[static_cast<size_t>(it - joints.begin())] == BoundKind::kBisected)
+      throw InputError(named + ": joint '" + name + "' is bisected, so it has no fixed half-width" +
+                       (params.bounds.bisect.empty()
+                            ? " (without 'bounds.bisect' the first three hinge joints are)"
+                            : " (it is in 'bounds.bisect')"));
+  }
   for (size_t i = 0; i < kinds.size(); ++i) {
     const RobotJoint& j = scene.joints()[i];
     if (kinds[i] == BoundKind::kBisected && !(2 * params.bounds.min_half_width < j.upper - j.lower))

@@ -40,9 +40,11 @@ Sweep sweep_of(const Scene& scene, const mjData& d, int i) {
   const mjModel& m = scene.model();
   const RobotJoint& joint = scene.joints()[static_cast<size_t>(i)];
   const int joint_body = m.jnt_bodyid[joint.id];
-  const Eigen::Vector3d anchor(d.xanchor[3 * joint.id], d.xanchor[3 * joint.id + 1], d.xanchor[3 * joint.id + 2]);
+  const Eigen::Vector3d anchor(d.xanchor[3 * joint.id], d.xanchor[3 * joint.id + 1],
+                               d.xanchor[3 * joint.id + 2]);
   const Eigen::Vector3d axis =
-      Eigen::Vector3d(d.xaxis[3 * joint.id], d.xaxis[3 * joint.id + 1], d.xaxis[3 * joint.id + 2]).normalized();
+      Eigen::Vector3d(d.xaxis[3 * joint.id], d.xaxis[3 * joint.id + 1], d.xaxis[3 * joint.id + 2])
+          .normalized();
   Sweep s;
   for (int g : scene.link_geoms()) {
     if (!moves_with(m, m.geom_bodyid[g], joint_body)) continue;
@@ -84,7 +86,8 @@ double sweep_side(RobotState& state, const Sweep& sweep, Eigen::VectorXd q, int 
     state.set(q);
     // A slide moves every point of its geoms by the step itself (lever 1).
     const double lever = slide ? 1.0 : std::max(sweep.lever, 1e-9);
-    const double advance = std::clamp(sweep_clearance(scene, state.data(), sweep) / lever, tolerance, max_step);
+    const double advance =
+        std::clamp(sweep_clearance(scene, state.data(), sweep) / lever, tolerance, max_step);
     const double next = sign > 0 ? std::min(limit, free + advance) : std::max(limit, free - advance);
     q[i] = next;
     if (!state.in_collision(q)) {
@@ -156,8 +159,8 @@ void tool_room(RobotState& state, const WaypointBounds& w, const RoomOptions& op
 
 }  // namespace
 
-RoomReport measure_room(const Scene& scene, const std::vector<WaypointBounds>& bounds, const RoomOptions& options,
-                        int threads) {
+RoomReport measure_room(const Scene& scene, const std::vector<WaypointBounds>& bounds,
+                        const RoomOptions& options, int threads) {
   const auto t0 = std::chrono::steady_clock::now();
   require_joint_counts(scene, bounds);
   if (options.tool_samples < 0 || options.max_waypoints < 0)
@@ -171,7 +174,8 @@ RoomReport measure_room(const Scene& scene, const std::vector<WaypointBounds>& b
                               : count;
   report.waypoints.resize(measured);
   for (size_t j = 0; j < measured; ++j)
-    report.waypoints[j].waypoint = measured == count ? j : (j * (count - 1) + (measured - 1) / 2) / (measured - 1);
+    report.waypoints[j].waypoint =
+        measured == count ? j : (j * (count - 1) + (measured - 1) / 2) / (measured - 1);
   detail::parallel_for(static_cast<int>(measured), threads, [&] {
     auto state = std::make_shared<RobotState>(scene);
     return [&, state](int j) {
@@ -183,7 +187,8 @@ RoomReport measure_room(const Scene& scene, const std::vector<WaypointBounds>& b
       for (int i = 0; i < n; ++i) {
         const FreeRange& f = room.free[static_cast<size_t>(i)];
         const double width = f.upper - f.lower;
-        if (width > options.tolerance) room.share[i] = std::clamp((w.upper[i] - w.lower[i]) / width, 0.0, 1.0);
+        if (width > options.tolerance)
+          room.share[i] = std::clamp((w.upper[i] - w.lower[i]) / width, 0.0, 1.0);
       }
       tool_room(*state, w, options, static_cast<std::uint64_t>(k), room);
     };

@@ -430,7 +430,8 @@ SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, 
       (params.grow != "none" || !params.max_half_width.empty())) {
     SafetyParams growth = params;
     if (dense) growth.grow = "none";
-    report.grow = grow_bounds(scene, bounds, report.segments, growth, certify_options(params, bound), threads);
+    report.grow =
+        grow_bounds(scene, bounds, report.segments, growth, certify_options(params, bound), threads);
     report.stats.add(report.grow.stats);
   }
   report.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -210,9 +210,9 @@ TimeModel fit_time_model(const std::vector<TimingSample>& samples) {
   return m;
 }
 
-void width_stats(const Scene& scene, const std::vector<WaypointBounds>& bounds, double min_width,
-                 CaseEval& e) {
-  const auto kinds = bound_kinds(scene);
+void width_stats(const Scene& scene, const BoundsParams& params, const std::vector<WaypointBounds>& bounds,
+                 double min_width, CaseEval& e) {
+  const auto kinds = bound_kinds(scene, params);
   e.bisected = 0;
   e.collapsed = 0;
   double width = 0, shortfall = 0;
@@ -302,7 +302,7 @@ CaseEval evaluate_case(TuningCase& c, const Params& params, const CfParams& cf, 
   e.cells = run.volume.cells_evaluated;
   e.near = near_pairs(c.scene(), c.path(), run.volume.boxes);
   e.cost_ms = model.predict(e.checks, e.boxes, e.near);
-  width_stats(c.scene(), run.bounds, objective.min_width, e);
+  width_stats(c.scene(), params.bounds, run.bounds, objective.min_width, e);
   const CfResult r = confidence_factor(c.scene(), run.bounds, cf, cf_threads);
   e.cf = r.cf;
   e.ci_low = r.ci_low;

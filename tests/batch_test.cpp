@@ -299,6 +299,39 @@ TEST_F(BatchTest, SimulateExpectationsJudgeTheClosedLoop) {
   EXPECT_EQ(far["expectations"][0]["measured"], held["measured"]["simulate_min_distance"]);
 }
 
+TEST_F(BatchTest, RoomExpectationsJudgeTheKeptShareAndTheToolsRoom) {
+  const json scenarios = {
+      {{"name", "roomy"},
+       {"from", "a"},
+       {"to", "b"},
+       {"expect", {{"room", {{"mean_share_min", 0.01}, {"tool_translation_min", 0.001}}}}}},
+      {{"name", "greedy"}, {"from", "a"}, {"to", "b"}, {"expect", {{"room", {{"mean_share_min", 1.0}}}}}}};
+  const auto r =
+      test::run_cli("batch " + suite(scenarios) + " --out " + path("results.json") + " --threads 1");
+  ASSERT_EQ(r.exit_code, 1) << r.out;
+  const json results = test::read_json(path("results.json"));
+  const json& roomy = results["scenarios"][0];
+  EXPECT_EQ(roomy["passed"], true) << roomy.dump(1);
+  const double share = roomy["measured"]["room_mean_share"].get<double>();
+  EXPECT_GT(share, 0.01);
+  EXPECT_LE(share, 1.0);
+  // The same bounds through `leeway bounds` give the same room.
+  // (The suite's default parameters, as a parameter file.)
+  const std::string params =
+      dir_.write("params.json", R"({"height_map": {"max_cells": 500}, "volume": {"reach_radius": 1.5}})");
+  const auto b =
+      test::run_cli("bounds " + path("cell.xml") + " --from a --to b --json --threads 1 --params " + params);
+  ASSERT_EQ(b.exit_code, 0) << b.out;
+  const json bounds = json::parse(b.out);
+  EXPECT_DOUBLE_EQ(bounds["room"]["mean_share"].get<double>(), share);
+  EXPECT_DOUBLE_EQ(bounds["room"]["waypoints"].back()["tool_translation"].get<double>(),
+                   roomy["measured"]["room_goal_tool_translation"].get<double>());
+  const json& greedy = results["scenarios"][1];
+  EXPECT_EQ(greedy["passed"], false);
+  EXPECT_EQ(greedy["expectations"][0]["title"], "room: mean kept share >= 1");
+  EXPECT_EQ(greedy["expectations"][0]["measured"], roomy["measured"]["room_mean_share"]);
+}
+
 TEST_F(BatchTest, ABadSuiteIsExitTwoBeforeAnyScenarioRunsAndWritesNothing) {
   json second = {{"name", "second"}, {"from", "a"}, {"to", "b"}};
   const auto with = [&](const std::string& key, const json& value) {
@@ -313,6 +346,10 @@ TEST_F(BatchTest, ABadSuiteIsExitTwoBeforeAnyScenarioRunsAndWritesNothing) {
        "scenario 2 'second': field 'expect.cf_mni' is not a known key"},
       {{passing(), with("expect", {{"cf_min", 1.5}})},
        "scenario 2 'second': field 'expect.cf_min' 1.5 must be"},
+      {{passing(), with("expect", {{"room", {{"share", 0.3}}}})},
+       "scenario 2 'second': field 'expect.room.share' is not a known key"},
+      {{passing(), with("expect", {{"room", {{"mean_share_min", 30}}}})},
+       "scenario 2 'second': field 'expect.room.mean_share_min' 30 must be"},
       {{passing(), with("colour", "red")}, "scenario 2 'second': field 'colour' is not a known key"},
       {{passing(), with("max_cells", -3)},
        "scenario 2 'second': field 'max_cells' -3 must be a whole number"},
@@ -321,6 +358,13 @@ TEST_F(BatchTest, ABadSuiteIsExitTwoBeforeAnyScenarioRunsAndWritesNothing) {
       {{passing(), with("path", "missing.json")}, "field 'path' excludes 'from' and 'to'"},
       {{passing(), with("params", {{"volume", {{"h_max", -1}}}})}, "scenario 2 'second': field 'params': "},
       {{passing(), with("params", 7)}, "field 'params' must be a parameter file's name or an object"},
+      // Joint names are checked against the scenario's robot before any scenario runs.
+      {{passing(), with("params", {{"bounds", {{"bisect", json::array({"elbow"})}}}})},
+       "scenario 2 'second': field 'params': " + path("cell.xml") +
+           ": parameter 'bounds.bisect' names joint 'elbow', which the robot does not have (joints: j1)"},
+      {{passing(), with("params", {{"bounds", {{"half_width", {{"j1", 0.1}}}}}})},
+       "scenario 2 'second': field 'params': " + path("cell.xml") +
+           ": parameter 'bounds.half_width.j1' = 0.1: joint 'j1' is bisected"},
       {{passing(), with("simulate", {{"human", "shove"}})}, "field 'simulate.human' 'shove' must be one of"},
       {{passing(), with("simulate", {{"human", "push-toward"}})}, "field 'simulate.target' is missing"},
       {{passing(), with("simulate", {{"amplitude", 1e6}})}, "field 'simulate.amplitude' 1000000.0 must be"},

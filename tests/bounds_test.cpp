@@ -6,9 +6,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <memory>
+#include <set>
+#include <string>
 #include <vector>
 
+#include "leeway/bounds_file.hpp"
 #include "leeway/cell_defaults.hpp"
 #include "leeway/error.hpp"
 #include "leeway/kinematics.hpp"
@@ -274,7 +278,7 @@ TEST_F(BoundsSceneTest, OneLinkWaypointIsBisectedBetweenTheWalls) {
   const Scene scene = Scene::load(dir.write("cell.xml", one_link_cell(kTwoWalls)));
   RobotState state(scene);
   const CollisionFn collides = [&state](const Eigen::VectorXd& q) { return state.in_collision(q); };
-  ASSERT_EQ(bound_kinds(scene), std::vector<BoundKind>{BoundKind::kBisected});
+  ASSERT_EQ(bound_kinds(scene, BoundsParams{}), std::vector<BoundKind>{BoundKind::kBisected});
   const WaypointBounds w = bound_waypoint(scene, collides, vec1(0.0), BoundsParams{});
   EXPECT_EQ(w.lower[0], -3.0);
   EXPECT_EQ(w.upper[0], 3.0);
@@ -325,7 +329,7 @@ TEST_F(DallaraBoundsTest, HomeToPatchBoundsHaveTheAlgorithmsProperties) {
   ASSERT_EQ(run.bounds.size(), 3u);
   ASSERT_GT(run.volume.boxes.size(), 0u);
   const Eigen::VectorXd lo = scene_->lower_limits(), hi = scene_->upper_limits();
-  const auto kinds = bound_kinds(*scene_);
+  const auto kinds = bound_kinds(*scene_, params_.bounds);
   ASSERT_EQ(kinds, (std::vector<BoundKind>{BoundKind::kBisected, BoundKind::kBisected, BoundKind::kBisected,
                                            BoundKind::kFixed, BoundKind::kFixed, BoundKind::kFixed}));
   const std::vector<int> bisected = {0, 1, 2};
@@ -460,7 +464,7 @@ TEST_F(BoundsSceneTest, FreeSpaceGivesLimitsAndTheRailGetsThreePercent) {
   // DLR: rail_x (slide, -9 .. 1 m) then the six hinges. Nothing collides: j1..j3 get their limits
   // after one check each per base, the wrist +- 0.2 rad and the rail +- 3 % of 10 m = +- 0.3 m.
   const Scene scene = Scene::load(workcell("dlr"));
-  ASSERT_EQ(bound_kinds(scene),
+  ASSERT_EQ(bound_kinds(scene, BoundsParams{}),
             (std::vector<BoundKind>{BoundKind::kLinear, BoundKind::kBisected, BoundKind::kBisected,
                                     BoundKind::kBisected, BoundKind::kFixed, BoundKind::kFixed,
                                     BoundKind::kFixed}));
@@ -517,6 +521,325 @@ TEST_F(BoundsSceneTest, RejectsNominalsOutsideTheLimitsOrOfTheWrongSize) {
   EXPECT_THROW(bound_waypoint(scene, never, Eigen::VectorXd::Zero(5), BoundsParams{}), InputError);
   q[1] = std::nan("");
   EXPECT_THROW(bound_waypoint(scene, never, q, BoundsParams{}), InputError);
+}
+
+// ---------------------------------------------------------------------------------------------
+// bounds.bisect and bounds.half_width: which joints Algorithm 3 bisects, per-joint fixed widths
+
+// A serial chain of n hinges as tools/chain_cell.py writes it (about z and y in turn, 1.6 m in all,
+// a 6 cm box per link on a fixed base), with every joint's range [-1.5, 1.5] rad and a wall whose
+// near face is the plane x = 0.25 (x 0.25 .. 0.35, y -1 .. 1, z 0.5 .. 2.5). Keyframes: a (straight
+// up) and b (j1 = 0.3, j2 = -0.2: turned, and tilted away from the wall).
+std::string chain_cell(int n) {
+  const double seg = 1.6 / n;
+  std::string bodies, closing, straight, bent;
+  for (int i = 0; i < n; ++i) {
+    bodies += "<body name=\"l" + std::to_string(i + 1) + "\" pos=\"0 0 " +
+              (i == 0 ? "0.2" : std::to_string(seg)) + "\"><joint name=\"j" + std::to_string(i + 1) +
+              "\" type=\"hinge\" axis=\"" + (i % 2 ? "0 1 0" : "0 0 1") +
+              "\" range=\"-1.5 1.5\" user=\"1.5\"/><geom name=\"g" + std::to_string(i + 1) +
+              "\" type=\"box\" size=\"0.03 0.03 " + std::to_string(0.4 * seg) + "\" pos=\"0 0 " +
+              std::to_string(0.5 * seg) + "\"/>\n";
+    closing += "</body>";
+    straight += " 0";
+    bent += i == 0 ? " 0.3" : i == 1 ? " -0.2" : " 0";
+  }
+  return R"(<mujoco model="chain">
+  <compiler angle="radian" autolimits="true"/>
+  <worldbody>
+    <body name="base"><geom name="base_box" type="box" size="0.1 0.1 0.1" pos="0 0 0.1"/>
+)" + bodies +
+         "<site name=\"tool0\" pos=\"0 0 " + std::to_string(seg) + "\"/>" + closing + R"(</body>
+    <geom name="wall" type="box" size="0.05 1 1" pos="0.3 0 1.5" contype="0" conaffinity="1"/>
+  </worldbody>
+  <keyframe><key name="a" qpos=")" +
+         straight.substr(1) + R"("/><key name="b" qpos=")" + bent.substr(1) + R"("/></keyframe>
+</mujoco>
+)";
+}
+
+BoundsParams bisecting(std::vector<std::string> joints) {
+  BoundsParams p;
+  p.bisect = std::move(joints);
+  return p;
+}
+
+TEST_F(BoundsSceneTest, TheFourthJointOfAChainIsBisectedToItsTouchAngle) {
+  // Four hinges, j4 (about y, pivot at z = 1.4) named in bounds.bisect: j1..j3 are fixed, j4 is
+  // bisected from the straight pose. The link l4 is the box x, y in [-0.03, 0.03], z in [0.04, 0.36]
+  // of its frame; turned by theta about y, its point of largest x is the corner (0.03, 0.36):
+  //   x(theta) = 0.03 cos(theta) + 0.36 sin(theta) = sqrt(0.1305) sin(theta + atan(0.03 / 0.36)),
+  // which reaches the wall face x = 0.25 at
+  //   theta* = asin(0.25 / sqrt(0.1305)) - atan(1 / 12) = 0.7644972 - 0.0831412 = 0.6811779,
+  // the corner then at z = 1.4 - 0.03 sin(theta*) + 0.36 cos(theta*) = 1.66, in front of the wall.
+  // The other links stay within |x| <= 0.1 (the base) at every probe.
+  test::TempDir dir;
+  const Scene scene = Scene::load(dir.write("chain.xml", chain_cell(4)));
+  RobotState state(scene);
+  const CollisionFn collides = [&state](const Eigen::VectorXd& q) { return state.obstacle_contact(q); };
+  const double theta = std::asin(0.25 / std::sqrt(0.1305)) - std::atan(0.03 / 0.36);
+  ASSERT_NEAR(theta, 0.6811779, 1e-7);
+  const Eigen::VectorXd q = Eigen::VectorXd::Zero(4);
+  auto at = [&q](double j4) {
+    Eigen::VectorXd x = q;
+    x[3] = j4;
+    return x;
+  };
+  EXPECT_FALSE(collides(at(theta - 1e-4)));
+  EXPECT_TRUE(collides(at(theta + 1e-4)));
+
+  // The thesis's rule bisects j1..j3 and gives j4 the wrist's fixed +- 0.2 rad.
+  EXPECT_EQ(bound_kinds(scene, BoundsParams{}),
+            (std::vector<BoundKind>{BoundKind::kBisected, BoundKind::kBisected, BoundKind::kBisected,
+                                    BoundKind::kFixed}));
+  const BoundsParams p = bisecting({"j4"});
+  ASSERT_EQ(bound_kinds(scene, p), (std::vector<BoundKind>{BoundKind::kFixed, BoundKind::kFixed,
+                                                           BoundKind::kFixed, BoundKind::kBisected}));
+  const WaypointBounds w = bound_waypoint(scene, collides, q, p);
+  // Upper side, from 0 to the limit 1.5, delta 0.01. By hand: 1.5 c, 0.75 c, 0.375 f, 0.5625 f,
+  // 0.65625 f, 0.703125 c, 0.6796875 f, 0.69140625 c -> B = 0.685546875, B - A = 0.0059 <= delta:
+  // A = 0.6796875 (= 87/128) after 8 checks, theta* - A = 0.0015 < delta.
+  EXPECT_EQ(w.upper[3], 0.6796875);
+  EXPECT_LE(w.upper[3], theta);
+  EXPECT_LT(theta - w.upper[3], 0.01);
+  // Lower side: the chain turns away from the wall, the limit -1.5 is free (1 check).
+  EXPECT_EQ(w.lower[3], -1.5);
+  // j1..j3: nominal +- wrist_half_width.
+  for (int j = 0; j < 3; ++j) {
+    EXPECT_EQ(w.lower[j], -0.2) << j;
+    EXPECT_EQ(w.upper[j], 0.2) << j;
+  }
+  EXPECT_EQ(w.collapsed, std::vector<bool>(4, false));
+  EXPECT_FALSE(w.nominal_in_volume);
+  EXPECT_EQ(w.checks, 1 + 8 + 1);
+}
+
+TEST_F(BoundsSceneTest, BisectedJointsAreBoundedBaseToTipWhateverTheListsOrder) {
+  // bounds.bisect = {j4, j2}: j2 first (from the nominal pose), then j4 from j2 at each of its bounds.
+  // Nothing collides, so every run is one check at the limit (+-1.5); the probes, in order:
+  test::TempDir dir;
+  const Scene scene = Scene::load(dir.write("chain.xml", chain_cell(4)));
+  std::vector<Eigen::VectorXd> probes;
+  const CollisionFn never = [&probes](const Eigen::VectorXd& x) {
+    probes.push_back(x);
+    return false;
+  };
+  const WaypointBounds w = bound_waypoint(scene, never, Eigen::VectorXd::Zero(4), bisecting({"j4", "j2"}));
+  auto pose = [](double j2, double j4) { return Eigen::VectorXd(Eigen::Vector4d(0, j2, 0, j4)); };
+  const std::vector<Eigen::VectorXd> expected = {
+      pose(0, 0),                         // nominal
+      pose(-1.5, 0),    pose(1.5, 0),     // j2: lower, upper
+      pose(-1.5, -1.5), pose(-1.5, 1.5),  // j4 with j2 at its lower bound
+      pose(1.5, -1.5),  pose(1.5, 1.5),   // j4 with j2 at its upper bound
+  };
+  ASSERT_EQ(probes.size(), expected.size());
+  for (size_t i = 0; i < probes.size(); ++i) EXPECT_EQ(probes[i], expected[i]) << "probe " << i;
+  EXPECT_EQ(w.checks, 7);
+  EXPECT_EQ(w.lower, Eigen::Vector4d(-0.2, -1.5, -0.2, -1.5));
+  EXPECT_EQ(w.upper, Eigen::Vector4d(0.2, 1.5, 0.2, 1.5));
+}
+
+TEST_F(BoundsSceneTest, FourBisectedJointsTakeTwoFourEightAndSixteenRuns) {
+  // A six-hinge chain with j1, j2, j4 and j5 bisected. Every probe collides: each run makes
+  // ceil(log2(D / delta)) = ceil(log2(1.5 / 0.01)) = ceil(7.23) = 8 checks (D = 1.5 on both sides of
+  // 0), every interval collapses to nominal +- min_half_width = +- 0.01, and the bases of a joint
+  // are every combination of the earlier bisected joints at +- 0.01. Runs per level: 2, 4, 8, 16:
+  // 1 + 8 x 30 = 241 checks.
+  test::TempDir dir;
+  const Scene scene = Scene::load(dir.write("chain.xml", chain_cell(6)));
+  std::vector<int> probes_of(6, 0);
+  std::set<std::vector<double>> j5_bases;
+  const CollisionFn always = [&](const Eigen::VectorXd& x) {
+    EXPECT_EQ(x[2], 0.0);  // the fixed joints stay nominal
+    EXPECT_EQ(x[5], 0.0);
+    // The moving joint is the last bisected one that is off the collapsed set {0, +-0.01}.
+    for (int j : {4, 3, 1, 0})
+      if (std::abs(x[j]) > 0.01) {
+        ++probes_of[static_cast<size_t>(j)];
+        if (j == 4) j5_bases.insert({x[0], x[1], x[3]});
+        break;
+      }
+    return true;
+  };
+  const BoundsParams p = bisecting({"j1", "j2", "j4", "j5"});
+  ASSERT_EQ(bound_kinds(scene, p),
+            (std::vector<BoundKind>{BoundKind::kBisected, BoundKind::kBisected, BoundKind::kFixed,
+                                    BoundKind::kBisected, BoundKind::kBisected, BoundKind::kFixed}));
+  const WaypointBounds w = bound_waypoint(scene, always, Eigen::VectorXd::Zero(6), p);
+  EXPECT_EQ(w.checks, 1 + 8 * (2 + 4 + 8 + 16));
+  EXPECT_TRUE(w.nominal_in_volume);
+  EXPECT_EQ(w.collapsed, (std::vector<bool>{true, true, false, true, true, false}));
+  EXPECT_EQ(probes_of, (std::vector<int>{8 * 2, 8 * 4, 0, 8 * 8, 8 * 16, 0}));
+  EXPECT_EQ(j5_bases.size(), 8u);  // (j1, j2, j4) in {-0.01, 0.01}^3
+  for (const auto& b : j5_bases)
+    for (double v : b) EXPECT_EQ(std::abs(v), 0.01);
+  EXPECT_EQ(w.lower[2], -0.2);
+  EXPECT_EQ(w.upper[5], 0.2);
+}
+
+TEST_F(BoundsSceneTest, SixBisectedJointsTakeSixtyFourRunsAtTheLastLevel) {
+  // The cap: six bisected joints of a seven-hinge chain, nothing colliding: one check per run,
+  // 2 + 4 + 8 + 16 + 32 + 64 = 126 runs and the nominal check.
+  test::TempDir dir;
+  const Scene scene = Scene::load(dir.write("chain.xml", chain_cell(7)));
+  const CollisionFn never = [](const Eigen::VectorXd&) { return false; };
+  const WaypointBounds w =
+      bound_waypoint(scene, never, Eigen::VectorXd::Zero(7), bisecting({"j1", "j2", "j3", "j4", "j5", "j7"}));
+  EXPECT_EQ(w.checks, 1 + 126);
+  EXPECT_EQ(w.lower[5], -0.2);
+  EXPECT_EQ(w.lower[6], -1.5);
+}
+
+TEST_F(BoundsSceneTest, PerJointHalfWidthsReplaceTheWristsAndTheRailsAndAreClamped) {
+  // Dallara: the patch pose with j5 = 2.2 (upper limit 2.2689); nothing collides.
+  const Scene scene = Scene::load(workcell("dallara"));
+  Eigen::VectorXd q(6);
+  q << 0.5, 0.734922, 0.0866255, -3.14159, 2.2, -1.11219;
+  const CollisionFn never = [](const Eigen::VectorXd&) { return false; };
+  BoundsParams p;
+  p.half_width = {{"j5", 0.3}, {"j6", 0.1}};
+  WaypointBounds w = bound_waypoint(scene, never, q, p);
+  EXPECT_NEAR(w.lower[3], -3.34159, 1e-12);  // j4: wrist_half_width, 0.2
+  EXPECT_NEAR(w.upper[3], -2.94159, 1e-12);
+  EXPECT_NEAR(w.lower[4], 1.9, 1e-12);  // j5: 0.3, clamped at its upper limit
+  EXPECT_NEAR(w.upper[4], 2.2689, 1e-12);
+  EXPECT_NEAR(w.lower[5], -1.21219, 1e-12);  // j6: 0.1
+  EXPECT_NEAR(w.upper[5], -1.01219, 1e-12);
+  EXPECT_EQ(fixed_half_width(scene, 3, p), 0.2);
+  EXPECT_EQ(fixed_half_width(scene, 4, p), 0.3);
+  // A zero half-width pins the joint to its nominal value.
+  p.half_width = {{"j6", 0.0}};
+  w = bound_waypoint(scene, never, q, p);
+  EXPECT_EQ(w.lower[5], q[5]);
+  EXPECT_EQ(w.upper[5], q[5]);
+  // With j4 bisected, j3 is fixed and may be given a width of its own.
+  p = bisecting({"j1", "j2", "j4"});
+  p.half_width = {{"j3", 0.05}};
+  w = bound_waypoint(scene, never, q, p);
+  EXPECT_NEAR(w.lower[2], 0.0366255, 1e-12);
+  EXPECT_NEAR(w.upper[2], 0.1366255, 1e-12);
+  EXPECT_EQ(w.lower[3], scene.joints()[3].lower);  // j4 bisected: the free limits
+  EXPECT_EQ(w.upper[3], scene.joints()[3].upper);
+
+  // DLR: the rail (-9 .. 1 m) gets an absolute half-width [m] instead of 3 % of its range.
+  const Scene dlr = Scene::load(workcell("dlr"));
+  Eigen::VectorXd r = dlr.keyframe("home").q;  // rail at -4 m
+  BoundsParams rail;
+  rail.half_width = {{"rail_x", 0.5}};
+  EXPECT_EQ(fixed_half_width(dlr, 0, rail), 0.5);
+  EXPECT_NEAR(fixed_half_width(dlr, 0, BoundsParams{}), 0.3, 1e-12);
+  w = bound_waypoint(dlr, never, r, rail);
+  EXPECT_NEAR(w.lower[0], -4.5, 1e-12);
+  EXPECT_NEAR(w.upper[0], -3.5, 1e-12);
+  r[0] = -8.9;
+  w = bound_waypoint(dlr, never, r, rail);
+  EXPECT_NEAR(w.lower[0], -9.0, 1e-12);  // clamped to the limit
+  EXPECT_NEAR(w.upper[0], -8.4, 1e-12);
+}
+
+TEST_F(BoundsSceneTest, JointChoicesTheRobotCannotTakeAreRefused) {
+  const Scene dallara = Scene::load(workcell("dallara"));
+  const Scene dlr = Scene::load(workcell("dlr"));
+  auto refusal = [](const Scene& scene, const std::function<void(Params&)>& set) {
+    Params p;
+    set(p);
+    return test::error_of([&] { validate_for_scene(p, scene); });
+  };
+  const std::string d = dallara.source() + ": ";
+  EXPECT_EQ(
+      refusal(dallara,
+              [](Params& p) {
+                p.bounds.bisect = {"j1", "j9"};
+              }),
+      d + "parameter 'bounds.bisect' names joint 'j9', which the robot does not have (joints: j1, j2, j3, "
+          "j4, j5, j6)");
+  EXPECT_EQ(
+      refusal(dlr,
+              [](Params& p) {
+                p.bounds.bisect = {"rail_x", "j1"};
+              }),
+      dlr.source() +
+          ": parameter 'bounds.bisect' names slide joint 'rail_x': only hinge joints are bisected (a slide "
+          "joint's half-width is 'bounds.linear_axis_tolerance' or 'bounds.half_width')");
+  EXPECT_EQ(
+      refusal(dallara,
+              [](Params& p) {
+                p.bounds.half_width = {{"j7", 0.1}};
+              }),
+      d + "parameter 'bounds.half_width.j7' = 0.1 names a joint the robot does not have (joints: j1, j2, "
+          "j3, j4, j5, j6)");
+  EXPECT_EQ(
+      refusal(dallara,
+              [](Params& p) {
+                p.bounds.half_width = {{"j2", 0.1}};
+              }),
+      d + "parameter 'bounds.half_width.j2' = 0.1: joint 'j2' is bisected, so it has no fixed half-width "
+          "(without 'bounds.bisect' the first three hinge joints are)");
+  EXPECT_EQ(
+      refusal(dallara,
+              [](Params& p) {
+                p.bounds.bisect = {"j1", "j2", "j4"};
+                p.bounds.half_width = {{"j4", 0.1}};
+              }),
+      d + "parameter 'bounds.half_width.j4' = 0.1: joint 'j4' is bisected, so it has no fixed half-width "
+          "(it is in 'bounds.bisect')");
+  // Params::validate's refusals come first (duplicates, the cap, the values).
+  EXPECT_EQ(refusal(dallara,
+                    [](Params& p) {
+                      p.bounds.bisect = {"j4", "j4"};
+                    }),
+            "parameter 'bounds.bisect' names joint 'j4' twice");
+  // The collapse guard's check now covers the joints bisect names: min_half_width 1.6 is more than
+  // half of j4's range on the chain (3 rad), when j4 is bisected only.
+  test::TempDir dir;
+  const Scene chain = Scene::load(dir.write("chain.xml", chain_cell(4)));
+  Params wide;
+  wide.bounds.min_half_width = 1.6;
+  EXPECT_THAT(test::error_of([&] { validate_for_scene(wide, chain); }), HasSubstr("joint 'j1'"));
+  wide.bounds.bisect = {"j4"};
+  EXPECT_THAT(
+      test::error_of([&] { validate_for_scene(wide, chain); }),
+      HasSubstr("'bounds.min_half_width' = 1.6 rad must be smaller than half the range of joint 'j4'"));
+  // The library itself refuses what it cannot bisect, also without validate_for_scene.
+  const CollisionFn never = [](const Eigen::VectorXd&) { return false; };
+  EXPECT_THROW(bound_waypoint(dallara, never, Eigen::VectorXd::Zero(6), bisecting({"elbow"})), InputError);
+  // Valid choices pass.
+  Params ok;
+  ok.bounds.bisect = {"j4", "j1", "j2"};
+  ok.bounds.half_width = {{"j3", 0.3}, {"j6", 0.0}};
+  EXPECT_NO_THROW(validate_for_scene(ok, dallara));
+  ok.bounds.bisect.clear();
+  ok.bounds.half_width = {{"rail_x", 1.0}, {"j4", 0.1}};
+  EXPECT_NO_THROW(validate_for_scene(ok, dlr));
+}
+
+TEST_F(BoundsSceneTest, TheBoundsFileRecordsTheChosenKinds) {
+  // The pipeline end to end on the chain: j2 and j4 bisected, j1 with a half-width of its own.
+  test::TempDir dir;
+  const Scene scene = Scene::load(dir.write("chain.xml", chain_cell(4)));
+  Params p;
+  p.height_map.max_cells = 200;
+  p.safety.mode = SafetyMode::kNone;
+  p.bounds.bisect = {"j4", "j2"};
+  p.bounds.half_width = {{"j1", 0.1}};
+  VolumeModel world(scene, p.height_map.max_cells + static_cast<int>(scene.obstacle_geoms().size()));
+  const auto path = keyframe_path(scene, "a", "b", 2);
+  const BoundsRun run = compute_bounds(scene, world, path, p, 1);
+  const nlohmann::json file = bounds_json(scene, run, p);
+  EXPECT_EQ(file.at("joint_bounding"),
+            nlohmann::json::parse(R"(["fixed", "bisected", "fixed", "bisected"])"));
+  EXPECT_EQ(file.at("params").at("bounds").at("bisect"), nlohmann::json::parse(R"(["j4", "j2"])"));
+  for (const auto& w : run.bounds) {
+    EXPECT_NEAR(w.upper[0] - w.q[0], 0.1, 1e-12);
+    EXPECT_NEAR(w.upper[2] - w.q[2], 0.2, 1e-12);
+  }
+  // Three threads for two waypoints give the same bounds (the runs of a level spread over them).
+  const auto two = bound_path(world, path, p.bounds, 3);
+  for (size_t i = 0; i < two.size(); ++i) {
+    EXPECT_EQ(two[i].lower, run.bounds[i].lower) << i;
+    EXPECT_EQ(two[i].upper, run.bounds[i].upper) << i;
+    EXPECT_EQ(two[i].checks, run.bounds[i].checks) << i;
+  }
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -180,6 +181,90 @@ TEST_F(CliBoundsTest, BadInputsExitTwoNameTheValueAndWriteNothing) {
     EXPECT_EQ(r.exit_code, 2) << c.args << "\n" << r.out;
     EXPECT_THAT(r.out, HasSubstr("leeway: error:")) << c.args;
     for (const auto& f : c.fragments) EXPECT_THAT(r.out, HasSubstr(f)) << c.args;
+    EXPECT_FALSE(std::filesystem::exists(out)) << c.args;
+    EXPECT_FALSE(std::filesystem::exists(csv)) << c.args;
+  }
+}
+
+TEST_F(CliBoundsTest, BisectAndHalfWidthChooseTheJoints) {
+  // The elbow-like j4 bisected instead of j3, j3 and j6 with half-widths of their own; no safety
+  // stage, so the bounds are those of Algorithms 2 and 3 and the fixed widths (clamped).
+  const auto r = run_cli("bounds " + workcell("dallara") +
+                         " --from home --to patch --max-cells 300 --safety none --threads 1 --json"
+                         " --bisect j4,j1,j2 --half-width j3=0.05,j6=0.1");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("joint_bounding"),
+            nlohmann::json::parse(R"(["bisected", "bisected", "fixed", "bisected", "fixed", "fixed"])"));
+  EXPECT_EQ(j.at("params").at("bounds").at("bisect"), nlohmann::json::parse(R"(["j4", "j1", "j2"])"));
+  EXPECT_EQ(j.at("params").at("bounds").at("half_width"),
+            nlohmann::json::parse(R"({"j3": 0.05, "j6": 0.1})"));
+  for (const auto& w : j.at("waypoints")) {
+    const double q2 = w["q"][2].get<double>(), q4 = w["q"][4].get<double>(), q5 = w["q"][5].get<double>();
+    EXPECT_NEAR(w["upper"][2].get<double>() - q2, 0.05, 1e-12);
+    EXPECT_NEAR(q2 - w["lower"][2].get<double>(), 0.05, 1e-12);
+    EXPECT_NEAR(w["upper"][4].get<double>() - q4, std::min(0.2, 2.2689 - q4), 1e-12);  // j5: the wrist's
+    EXPECT_NEAR(w["upper"][5].get<double>() - q5, 0.1, 1e-12);
+  }
+  // A parameter file gives the same as the flags.
+  const std::string params = dir_.write(
+      "p.json", R"({"bounds": {"bisect": ["j4", "j1", "j2"], "half_width": {"j3": 0.05, "j6": 0.1}}})");
+  const auto f =
+      run_cli("bounds " + workcell("dallara") +
+              " --from home --to patch --max-cells 300 --safety none --threads 1 --json --params " + params);
+  ASSERT_EQ(f.exit_code, 0) << f.out;
+  const auto k = nlohmann::json::parse(f.out);
+  EXPECT_EQ(k.at("waypoints"), j.at("waypoints"));
+  EXPECT_EQ(k.at("joint_bounding"), j.at("joint_bounding"));
+}
+
+TEST_F(CliBoundsTest, BisectAndHalfWidthRefusalsNameTheFlagTheJointAndTheValue) {
+  const std::string cell = workcell("dallara");
+  const std::string out = (dir_.path() / "out.json").string();
+  const std::string csv = (dir_.path() / "out.csv").string();
+  const std::string bounds = "bounds " + cell + " --from home --to patch --max-cells 300 --out " + out + " ";
+  const std::string sweep = "sweep " + cell + " --from home --to patch --max-cells 100 --csv " + csv + " ";
+  const std::string both = dir_.write("both.json", R"({"bounds": {"half_width": {"j4": 0.1}}})");
+  struct Case {
+    std::string args;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {bounds + "--bisect j1,j2,elbow", "--bisect j1,j2,elbow: " + cell +
+                                            ": parameter 'bounds.bisect' names joint 'elbow', which the "
+                                            "robot does not have (joints: j1, j2, j3, j4, "
+                                            "j5, j6)"},
+      {bounds + "--bisect j1,j2,j1", "--bisect j1,j2,j1: parameter 'bounds.bisect' names joint 'j1' twice"},
+      {bounds + "--bisect j1,j2,j3,j4,j5,j6,j7",
+       "--bisect j1,j2,j3,j4,j5,j6,j7: parameter 'bounds.bisect' names 7 joints; at most 6 can be bisected"},
+      {bounds + "--bisect j1,", "--bisect 'j1,': an empty item"},
+      {bounds + "--bisect ''", "--bisect: is empty; give joint names"},
+      {bounds + "--half-width j5", "--half-width 'j5' must be NAME=VALUE"},
+      {bounds + "--half-width j5=0.3x", "--half-width 'j5=0.3x' must be NAME=VALUE"},
+      {bounds + "--half-width =0.3", "--half-width '=0.3' must be NAME=VALUE"},
+      {bounds + "--half-width j5=0.3,j5=0.1", "--half-width j5=0.3,j5=0.1: joint 'j5' is given twice"},
+      {bounds + "--half-width j5=-0.3",
+       "--half-width j5=-0.3: parameter 'bounds.half_width.j5' = -0.3 must be between 0 and 1000"},
+      {bounds + "--half-width j5=inf",
+       "--half-width j5=inf: parameter 'bounds.half_width.j5' = inf must be a finite number"},
+      {bounds + "--half-width j5=2000",
+       "--half-width j5=2000: parameter 'bounds.half_width.j5' = 2000 must be between 0 and 1000"},
+      {bounds + "--half-width j2=0.3",
+       "--half-width j2=0.3: " + cell +
+           ": parameter 'bounds.half_width.j2' = 0.3: joint 'j2' is bisected, so it has no fixed half-width "
+           "(without 'bounds.bisect' the first three hinge joints are)"},
+      {bounds + "--half-width wrist=0.3",
+       "parameter 'bounds.half_width.wrist' = 0.3 names a joint the robot"},
+      // The file's half-width for j4 and the flag's bisected j4.
+      {bounds + "--params " + both + " --bisect j1,j2,j4",
+       "--bisect j1,j2,j4: " + cell + ": parameter 'bounds.half_width.j4' = 0.1: joint 'j4' is bisected"},
+      {sweep + "--bisect j9", "--bisect j9: " + cell + ": parameter 'bounds.bisect' names joint 'j9'"},
+  };
+  for (const auto& c : cases) {
+    const auto r = run_cli(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args << "\n" << r.out;
+    EXPECT_THAT(r.out, HasSubstr("leeway: error: ")) << c.args;
+    EXPECT_THAT(r.out, HasSubstr(c.message)) << c.args;
     EXPECT_FALSE(std::filesystem::exists(out)) << c.args;
     EXPECT_FALSE(std::filesystem::exists(csv)) << c.args;
   }

@@ -5,7 +5,9 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <map>
 #include <string>
+#include <vector>
 
 #include "leeway/error.hpp"
 #include "test_util.hpp"
@@ -75,6 +77,8 @@ Params unusual() {
   p.bounds.min_half_width = 0.02;
   p.bounds.wrist_half_width = 0.3;
   p.bounds.linear_axis_tolerance = 0.05;
+  p.bounds.bisect = {"j4", "j1", "j2"};  // any order: bounded in model order
+  p.bounds.half_width = {{"j5", 0.35}, {"rail_x", 0.5}};
   p.cf.windows = 12;
   p.cf.samples = 500;
   p.cf.seed = 18446744073709551615ull;  // the largest seed: JSON must carry all 64 bits
@@ -107,6 +111,8 @@ void expect_equal(const Params& a, const Params& b) {
   EXPECT_EQ(a.bounds.min_half_width, b.bounds.min_half_width);
   EXPECT_EQ(a.bounds.wrist_half_width, b.bounds.wrist_half_width);
   EXPECT_EQ(a.bounds.linear_axis_tolerance, b.bounds.linear_axis_tolerance);
+  EXPECT_EQ(a.bounds.bisect, b.bounds.bisect);
+  EXPECT_EQ(a.bounds.half_width, b.bounds.half_width);
   EXPECT_EQ(a.cf.windows, b.cf.windows);
   EXPECT_EQ(a.cf.samples, b.cf.samples);
   EXPECT_EQ(a.cf.seed, b.cf.seed);
@@ -136,7 +142,13 @@ TEST(ParamsJsonTest, KeysAreTheFieldNames) {
   EXPECT_EQ(j.at("height_map").size(), 6u);
   EXPECT_EQ(j.at("volume").size(), 14u);  // 13 of section 4.1 and 3.2 plus trail_margin
   EXPECT_EQ(j.at("categorize").size(), 2u);
-  EXPECT_EQ(j.at("bounds").size(), 5u);  // four of sections 3.3 and 4.2.3 plus self_collision
+  // Four of sections 3.3 and 4.2.3, self_collision, bisect and half_width.
+  EXPECT_EQ(j.at("bounds").size(), 7u);
+  EXPECT_EQ(j.at("bounds").at("bisect"), json::parse(R"(["j4", "j1", "j2"])"));
+  EXPECT_EQ(j.at("bounds").at("half_width"), json::parse(R"({"j5": 0.35, "rail_x": 0.5})"));
+  // The defaults: the thesis's rule and no per-joint half-width, as [] and {}.
+  EXPECT_EQ(to_json(Params{}).at("bounds").at("bisect"), json::array());
+  EXPECT_EQ(to_json(Params{}).at("bounds").at("half_width"), json::object());
   EXPECT_EQ(to_json(Params{}).at("bounds").at("self_collision"), false);
   EXPECT_EQ(to_json(preset_params("leeway")).at("bounds").at("self_collision"), true);
   EXPECT_EQ(to_json(preset_params("thesis")).at("bounds").at("self_collision"), false);
@@ -172,6 +184,10 @@ TEST(ParamsJsonTest, WrongTypesAreErrors) {
       {R"({"height_map": {"max_cells": 99999999999}})", "'height_map.max_cells'"},  // beyond int
       {R"({"cf": {"seed": -1}})", "'cf.seed'"},
       {R"({"cf": {"windows": [30]}})", "'cf.windows'"},
+      {R"({"bounds": {"bisect": "j1,j2"}})", "'bounds.bisect' must be a list of joint names"},
+      {R"({"bounds": {"bisect": ["j1", 2]}})", "'bounds.bisect' must be a list of joint names"},
+      {R"({"bounds": {"half_width": [0.3]}})", "'bounds.half_width' must be an object of joint names"},
+      {R"({"bounds": {"half_width": {"j5": "0.3"}}})", "'bounds.half_width.j5' must be a number"},
   };
   for (const auto& c : cases) {
     const std::string m = error_of([&] { params_from_json(json::parse(c[0]), "p.json"); });
@@ -180,6 +196,74 @@ TEST(ParamsJsonTest, WrongTypesAreErrors) {
   }
   const std::string m = error_of([] { params_from_json(json::array(), "p.json"); });
   EXPECT_NE(m.find("p.json"), std::string::npos) << m;
+}
+
+TEST(ParamsJsonTest, JointListsReplaceTheBase) {
+  // A file's 'bounds.bisect' and 'bounds.half_width' replace the base's whole list and map.
+  Params base;
+  base.bounds.bisect = {"j1", "j2", "j3"};
+  base.bounds.half_width = {{"j5", 0.3}, {"j6", 0.1}};
+  const Params p = params_from_json(
+      json::parse(R"({"bounds": {"bisect": ["j1", "j2", "j4"], "half_width": {"j3": 0.25}}})"), "p.json",
+      base);
+  EXPECT_EQ(p.bounds.bisect, (std::vector<std::string>{"j1", "j2", "j4"}));
+  EXPECT_EQ(p.bounds.half_width, (std::map<std::string, double>{{"j3", 0.25}}));
+  // Empty values give back the defaults: the thesis's rule, no per-joint widths.
+  const Params q =
+      params_from_json(json::parse(R"({"bounds": {"bisect": [], "half_width": {}}})"), "p.json", base);
+  EXPECT_TRUE(q.bounds.bisect.empty());
+  EXPECT_TRUE(q.bounds.half_width.empty());
+}
+
+TEST(ParamsValidateTest, JointListsAreRefusedWithTheJointAndTheValue) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  struct Case {
+    std::function<void(Params&)> set;
+    std::string message;
+  };
+  const Case cases[] = {
+      {[](Params& p) {
+         p.bounds.bisect = {"j1", "j2", "j1"};
+       },
+       "parameter 'bounds.bisect' names joint 'j1' twice"},
+      {[](Params& p) {
+         p.bounds.bisect = {"j1", ""};
+       },
+       "parameter 'bounds.bisect' holds an empty joint name"},
+      {[](Params& p) { p.bounds.bisect = {"a", "b", "c", "d", "e", "f", "g"}; },
+       "parameter 'bounds.bisect' names 7 joints; at most 6 can be bisected (the sixth takes 64 Algorithm-2 "
+       "runs per waypoint, each further one doubles them)"},
+      {[](Params& p) {
+         p.bounds.half_width = {{"j5", -0.1}};
+       },
+       "parameter 'bounds.half_width.j5' = -0.1 must be between 0 and 1000"},
+      {[](Params& p) {
+         p.bounds.half_width = {{"j5", 1001}};
+       },
+       "parameter 'bounds.half_width.j5' = 1001 must be between 0 and 1000"},
+      {[=](Params& p) {
+         p.bounds.half_width = {{"j6", nan}};
+       },
+       "parameter 'bounds.half_width.j6' = nan must be a finite number"},
+      {[](Params& p) {
+         p.bounds.half_width = {{"", 0.1}};
+       },
+       "parameter 'bounds.half_width' holds an empty joint name"},
+  };
+  for (const auto& c : cases) {
+    Params p;
+    c.set(p);
+    EXPECT_EQ(error_of([&] { p.validate(); }), c.message);
+  }
+  // Six joints and the bounds of the range are accepted.
+  Params p;
+  p.bounds.bisect = {"a", "b", "c", "d", "e", "f"};
+  p.bounds.half_width = {{"g", 0.0}, {"h", 1000.0}};
+  EXPECT_NO_THROW(p.validate());
+  // From a file, the file is named first.
+  EXPECT_EQ(
+      error_of([] { params_from_json(json::parse(R"({"bounds": {"half_width": {"j5": -1}}})"), "p.json"); }),
+      "p.json: parameter 'bounds.half_width.j5' = -1 must be between 0 and 1000");
 }
 
 TEST(ParamsJsonTest, OutOfRangeValuesAreValidated) {

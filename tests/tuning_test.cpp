@@ -273,7 +273,7 @@ TEST_F(TuningTest, WidthShortfallCountsCollapsedAsOneAndNarrowPartly) {
   WaypointBounds wide = w;
   wide.upper[0] = 1.0;
   CaseEval e;
-  width_stats(scene, {w, c, wide}, 0.1, e);
+  width_stats(scene, BoundsParams{}, {w, c, wide}, 0.1, e);
   EXPECT_EQ(e.bisected, 3);
   EXPECT_EQ(e.collapsed, 1);
   EXPECT_NEAR(e.shortfall, (0.6 + 1.0 + 0.0) / 3, 1e-12);

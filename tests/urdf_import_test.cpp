@@ -518,6 +518,24 @@ TEST(UrdfImportCliTest, SevenJointArmEndToEnd) {
   ASSERT_EQ(cf.exit_code, 0) << cf.out;
   EXPECT_EQ(nlohmann::json::parse(cf.out).at("cf").get<double>(),
             1.0);  // certified bounds: no sample collides
+
+  // The elbow a4 bisected instead of the upper-arm roll a3 (docs/robots.md), the roll kept tight.
+  const fs::path elbow = dir.path() / "elbow.json";
+  const auto e =
+      test::run_cli("bounds " + quoted(cell) +
+                    " --from home --to lean --waypoints 3 --threads 1 --bisect a1,a2,a4 --half-width "
+                    "a3=0.1 --out " +
+                    quoted(elbow));
+  ASSERT_EQ(e.exit_code, 0) << e.out;
+  const auto elbow_file = test::read_json(elbow);
+  EXPECT_EQ(elbow_file.at("joint_bounding"),
+            nlohmann::json({"bisected", "bisected", "fixed", "bisected", "fixed", "fixed", "fixed"}));
+  for (const auto& w : elbow_file.at("waypoints"))
+    EXPECT_LE(w.at("upper")[2].get<double>(), w.at("q")[2].get<double>() + 0.1);
+  const auto elbow_cf =
+      test::run_cli("cf " + quoted(cell) + " " + quoted(elbow) + " --samples 2000 --threads 1 --json");
+  ASSERT_EQ(elbow_cf.exit_code, 0) << elbow_cf.out;
+  EXPECT_EQ(nlohmann::json::parse(elbow_cf.out).at("cf").get<double>(), 1.0);
 }
 
 TEST(UrdfImportCliTest, FourJointArmPlansAndBounds) {

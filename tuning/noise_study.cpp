@@ -53,7 +53,7 @@ int noise_study(Problem& pb, std::ostream& log) {
         run = t.run;
       }
       CaseEval e;
-      leeway::width_stats(c.scene(), run.bounds, o.objective.min_width, e);
+      leeway::width_stats(c.scene(), p.bounds, run.bounds, o.objective.min_width, e);
       std::vector<double> cfs;
       for (std::uint64_t s = 0; s < 3; ++s) {
         leeway::CfParams cp = o.cf;

@@ -21,6 +21,8 @@ struct Expectations {
   std::optional<double> time_max;               //!< the method's time <= this [s]; a soft warning only
   std::optional<long> simulate_contacts_max;    //!< closed-loop steps with a contact <= this
   std::optional<double> simulate_min_distance;  //!< closed-loop smallest distance >= this [m]
+  std::optional<double> room_mean_share_min;    //!< the room's mean kept share >= this (fraction, 0..1)
+  std::optional<double> room_tool_translation_min;  //!< the tool's room at the goal >= this [m]
 };
 
 //! One scenario of a suite, validated.

@@ -39,8 +39,8 @@ double bound_lower(const CollisionFn& collides, Eigen::VectorXd q, int j, double
 
 //! How a joint's interval was obtained.
 enum class BoundKind {
-  kBisected,  //!< Algorithms 2 and 3 (the first three hinge joints)
-  kFixed,     //!< a fixed half-width around nominal (further hinge joints: the wrist)
+  kBisected,  //!< Algorithms 2 and 3 (bounds.bisect, by default the first three hinge joints)
+  kFixed,     //!< a fixed half-width around nominal (the other hinge joints: the wrist)
   kLinear,    //!< a fraction of the range around nominal (slide joints: the linear axis)
 };
 
@@ -81,12 +81,19 @@ WaypointBounds bound_waypoint(const Scene& scene, const CollisionFn& collides, c
 //! @throws InputError naming the waypoint and the scene otherwise.
 void require_joint_counts(const Scene& scene, const std::vector<WaypointBounds>& bounds);
 
-//! The kind of every joint, in order.
-std::vector<BoundKind> bound_kinds(const Scene& scene);
+//! The kind of every joint, in order: the hinge joints named in `params.bisect` (when it is empty,
+//! the first three hinge joints) are bisected, the other hinge joints fixed, slide joints linear.
+//! @throws InputError naming the scene, the parameter and the joint when `params.bisect` names a
+//! joint the scene does not have or a slide joint.
+std::vector<BoundKind> bound_kinds(const Scene& scene, const BoundsParams& params);
+
+//! The fixed half-width of joint `index` of kind kFixed or kLinear [rad or m]: its entry in
+//! `params.half_width`, otherwise wrist_half_width (hinge) or linear_axis_tolerance x range (slide).
+double fixed_half_width(const Scene& scene, int index, const BoundsParams& params);
 
 //! Bounds of every waypoint against the volume in `world`, spread over `threads` threads (one
 //! VolumeChecker each): one waypoint per task when there are at least as many waypoints as threads,
-//! otherwise waypoint after waypoint with the 2, 4 and 8 Algorithm-2 runs of each joint level of
+//! otherwise waypoint after waypoint with the 2, 4, 8 ... Algorithm-2 runs of each joint level of
 //! Algorithm 3 spread over the threads. Deterministic: the result, checks included, does not depend
 //! on the thread count.
 std::vector<WaypointBounds> bound_path(const VolumeModel& world, const std::vector<Eigen::VectorXd>& path,

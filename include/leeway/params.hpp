@@ -8,6 +8,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 namespace leeway {
 
@@ -32,6 +33,9 @@ constexpr double kMinMapSide = 1e-3;
 constexpr double kMinGoalDz = 1e-5;
 //! The smallest Algorithm-2 step 'bounds.resolution' [rad] (smaller ones run for ever).
 constexpr double kMinResolution = 1e-6;
+//! The most joints 'bounds.bisect' may name: Algorithm 3 bounds the k-th bisected joint from 2^(k-1)
+//! bases, so the sixth takes 64 Algorithm-2 runs and a seventh would double that again.
+constexpr int kMaxBisected = 6;
 
 //! The height-map of section 3.2.1.
 struct HeightMapParams {
@@ -79,9 +83,16 @@ struct BoundsParams {
   //! Collapse guard (section 3.3): a bisected joint whose interval came out narrower than
   //! `resolution` (lower = upper = nominal) gets nominal +- this, clamped to its limits [rad or m]
   double min_half_width = 0.01;
-  //! fixed half-width around nominal of every hinge joint after the third (the wrist) [rad]
+  //! fixed half-width around nominal of every hinge joint that is not bisected (the wrist) [rad]
   double wrist_half_width = 0.2;
   double linear_axis_tolerance = 0.03;  //!< slide joints: half-width as a fraction of the joint's range
+  //! The hinge joints Algorithm 3 bisects, by name; bounded in model order (base to tip) whatever the
+  //! order here, at most kMaxBisected. Empty: the thesis's rule, the first three hinge joints.
+  std::vector<std::string> bisect;
+  //! Per-joint fixed half-width around nominal [rad or m], by joint name: replaces wrist_half_width
+  //! for a hinge joint and linear_axis_tolerance x range for a slide joint. Bisected joints cannot be
+  //! named.
+  std::map<std::string, double> half_width;
   //! A probe where two robot geoms touch (Scene::self_pairs()) counts as colliding. Not in the
   //! thesis (false, its probes see the volume only); the leeway preset sets it.
   bool self_collision = false;

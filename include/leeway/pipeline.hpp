@@ -28,8 +28,9 @@ struct BoundsRun {
 };
 
 //! Checks `params` against the robot of `scene` (Params::validate checks them alone):
-//! 'bounds.min_half_width' must be smaller than half the range of every bisected (hinge) joint, or
-//! the collapse guard would "widen" an interval to the joint's whole range.
+//! 'bounds.bisect' must name hinge joints of the robot; 'bounds.half_width' joints of the robot that
+//! are not bisected; 'bounds.min_half_width' must be smaller than half the range of every bisected
+//! (hinge) joint, or the collapse guard would "widen" an interval to the joint's whole range.
 //! @throws InputError naming the parameter, the joint, the file and the values.
 void validate_for_scene(const Params& params, const Scene& scene);
 

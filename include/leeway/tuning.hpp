@@ -193,9 +193,10 @@ void score_case(CaseEval& e, const Objective& objective);
 //! The aggregate of the per-case scores: mean, or minimum when objective.worst_case.
 double aggregate_score(const std::vector<CaseEval>& evals, const Objective& objective);
 
-//! Width statistics of bounds: fills bisected, collapsed, mean_width and shortfall of `e`.
-void width_stats(const Scene& scene, const std::vector<WaypointBounds>& bounds, double min_width,
-                 CaseEval& e);
+//! Width statistics of bounds: fills bisected, collapsed, mean_width and shortfall of `e` (the
+//! bisected joints are those of bound_kinds(scene, params)).
+void width_stats(const Scene& scene, const BoundsParams& params, const std::vector<WaypointBounds>& bounds,
+                 double min_width, CaseEval& e);
 
 //! The tuned parameter file: `base_json` (may be empty) with the tuned keys set from `p`
 //! (height_map.max_cells and the volume keys of tuned_variables()). `leeway bounds --params` reads it.

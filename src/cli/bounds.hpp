@@ -19,6 +19,7 @@ struct BoundsArgs {
   std::string params;                //!< parameter file (JSON)
   std::string preset = "leeway";     //!< parameter set
   std::string safety;                //!< safety mode; empty: the preset's
+  JointBoundsOptions joints;         //!< --bisect, --half-width
   std::string out;                   //!< bounds file to write (JSON); empty: none
   std::string export_mjcf;           //!< the cell with its volume as MJCF; empty: none
   std::string export_mjb;            //!< the same compiled, as MJB; empty: none

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <regex>
 #include <thread>
 #include <tuple>
@@ -17,6 +18,7 @@
 #include "leeway/cell_defaults.hpp"
 #include "leeway/endpoints.hpp"
 #include "leeway/file_io.hpp"
+#include "leeway/pipeline.hpp"
 #include "leeway/planner.hpp"
 
 namespace leeway::cli {
@@ -52,6 +54,95 @@ void add_preset_options(CLI::App* sub, std::string& preset, std::string& safety)
                   "certified (every interval proven free of the obstacles), sampled (an epsilon-delta\n"
                   "sampling test) or none (the thesis's bounds as they are); default: the preset's")
       ->check(non_empty_check("certified, sampled or none"));
+}
+
+void add_joint_bounds_options(CLI::App* sub, JointBoundsOptions& options) {
+  sub->add_option("--bisect", options.bisect,
+                  "Joints Algorithm 3 bisects, e.g. j1,j2,j4 (hinge joints, at most 6, bounded base to\n"
+                  "tip); default: the parameters' bounds.bisect, or the first three hinge joints")
+      ->check(non_empty_check("joint names, e.g. j1,j2,j4"));
+  sub->add_option("--half-width", options.half_width,
+                  "Fixed half-widths of joints that are not bisected [rad or m], e.g. j5=0.3,j6=0.1;\n"
+                  "default: bounds.wrist_half_width (hinge), bounds.linear_axis_tolerance (slide)")
+      ->check(non_empty_check("NAME=VALUE pairs, e.g. j5=0.3,j6=0.1"));
+  sub->add_option("--grow", options.grow,
+                  "Certified mode: the joints grown beyond the guide toward their free range: all, none\n"
+                  "or names, e.g. j4,j5,j6; default: the parameters' safety.grow (all)")
+      ->check(non_empty_check("all, none or joint names, e.g. j4,j5,j6"));
+  sub->add_option("--max-half-width", options.max_half_width,
+                  "Certified mode: the largest half-width a joint may keep [rad or m], e.g. j5=0.5,j6=0.3;\n"
+                  "default: the parameters' safety.max_half_width (none)")
+      ->check(non_empty_check("NAME=VALUE pairs, e.g. j5=0.5,j6=0.3"));
+}
+
+namespace {
+
+// "a,b,c" -> {"a", "b", "c"}; an empty item ("a,,b", "a,") is refused.
+std::vector<std::string> split_list(const std::string& text, const std::string& flag) {
+  std::vector<std::string> items;
+  size_t start = 0;
+  while (true) {
+    const size_t comma = text.find(',', start);
+    const std::string item =
+        text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    if (item.empty())
+      throw InputError(flag + " '" + text + "': an empty item (give comma-separated items without spaces)");
+    items.push_back(item);
+    if (comma == std::string::npos) return items;
+    start = comma + 1;
+  }
+}
+
+// "j5=0.3,j6=0.1" -> {{"j5", 0.3}, {"j6", 0.1}}; `what` names the value in the messages.
+std::map<std::string, double> joint_values(const std::string& text, const std::string& flag,
+                                           const std::string& what) {
+  std::map<std::string, double> values;
+  for (const std::string& item : split_list(text, flag)) {
+    const size_t eq = item.find('=');
+    const std::string name = item.substr(0, eq);
+    const std::string value = eq == std::string::npos ? "" : item.substr(eq + 1);
+    char* end = nullptr;
+    const double v = std::strtod(value.c_str(), &end);
+    if (eq == std::string::npos || name.empty() || value.empty() || *end != '\0')
+      throw InputError(flag + " '" + item + "' must be NAME=VALUE, a joint and its " + what + " [rad or m]");
+    if (!values.emplace(name, v).second)
+      throw InputError(flag + " " + text + ": joint '" + name + "' is given twice");
+  }
+  return values;
+}
+
+}  // namespace
+
+void apply_joint_bounds_options(const Scene& scene, const JointBoundsOptions& options, Params& p) {
+  if (options.bisect.empty() && options.half_width.empty() && options.grow.empty() &&
+      options.max_half_width.empty())
+    return;
+  // The preset, the cell's and the file's parameters alone first, so that what is refused below
+  // comes from the flags.
+  validate_for_scene(p, scene);
+  std::string given;
+  if (!options.bisect.empty()) {
+    p.bounds.bisect = split_list(options.bisect, "--bisect");
+    given = "--bisect " + options.bisect;
+  }
+  if (!options.half_width.empty()) {
+    p.bounds.half_width = joint_values(options.half_width, "--half-width", "half-width");
+    given += (given.empty() ? "" : " / ") + std::string("--half-width ") + options.half_width;
+  }
+  if (!options.grow.empty()) {
+    split_list(options.grow, "--grow");  // refuses empty items
+    p.safety.grow = options.grow;
+    given += (given.empty() ? "" : " / ") + std::string("--grow ") + options.grow;
+  }
+  if (!options.max_half_width.empty()) {
+    p.safety.max_half_width = joint_values(options.max_half_width, "--max-half-width", "largest half-width");
+    given += (given.empty() ? "" : " / ") + std::string("--max-half-width ") + options.max_half_width;
+  }
+  try {
+    validate_for_scene(p, scene);
+  } catch (const InputError& e) {
+    throw InputError(given + ": " + e.what());
+  }
 }
 
 Eigen::VectorXd configuration(const Scene& scene, const std::string& q, const std::string& key,

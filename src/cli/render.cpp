@@ -70,6 +70,7 @@ CLI::App* add_render(CLI::App& app, RenderArgs& args) {
   sub->add_option("--params", args.params, "Parameter file (JSON; with --from/--to)")
       ->check(file_name_check());
   add_preset_options(sub, args.preset, args.safety);
+  add_joint_bounds_options(sub, args.joints);
   sub->add_option("--threads", args.threads, "Worker threads")->capture_default_str();
   sub->final_callback([sub, &args] { args.max_cells_given = sub->count("--max-cells") > 0; });
   return sub;
@@ -125,6 +126,7 @@ int run_render(const RenderArgs& args) {
   Params p = load_params(scene, args.preset, args.params, args.safety);
   if (args.max_cells_given) p.height_map.max_cells = args.max_cells;
   p.validate();
+  apply_joint_bounds_options(scene, args.joints, p);
   const bool show_volume = args.volume == "on";
 
   std::vector<WaypointBounds> bounds;

@@ -24,6 +24,7 @@ struct RenderArgs {
   std::string params;               //!< parameter file (with --from/--to)
   std::string preset = "leeway";    //!< parameter set (with --from/--to)
   std::string safety;               //!< safety mode (with --from/--to); empty: the preset's
+  JointBoundsOptions joints;        //!< --bisect, --half-width (with --from/--to)
   int max_cells = 0;                //!< MAX_cells, used when max_cells_given
   bool max_cells_given = false;     //!< --max-cells was on the command line (set by the parser)
   int waypoints = 2;                //!< waypoints of the joint-linear path (with --from/--to)

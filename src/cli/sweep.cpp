@@ -65,6 +65,7 @@ CLI::App* add_sweep(CLI::App& app, SweepArgs& args) {
                   "Comma-separated MAX_cells values (default: the thesis's 20)");
   sub->add_option("--params", args.params, "Parameter file (JSON)")->check(file_name_check());
   add_preset_options(sub, args.preset, args.safety);
+  add_joint_bounds_options(sub, args.joints);
   sub->add_option("--csv", args.csv, "Also write the table as CSV here")->check(file_name_check());
   sub->add_option("--plot", args.plot,
                   "Also plot boxes, time and CF against MAX_cells here (.svg or .png), beside the thesis's\n"
@@ -86,7 +87,8 @@ CLI::App* add_sweep(CLI::App& app, SweepArgs& args) {
 
 int run_sweep(const SweepArgs& args) {
   const auto scene = Scene::load(args.cell, scene_options(kDefaultTool, args.checker));
-  const Params base = load_params(scene, args.preset, args.params, args.safety);
+  Params base = load_params(scene, args.preset, args.params, args.safety);
+  apply_joint_bounds_options(scene, args.joints, base);
   // CF settings: the parameter file's cf section unless given on the command line.
   CfParams cf = args.cf;
   if (!args.windows_given) cf.windows = base.cf.windows;
@@ -143,7 +145,7 @@ int run_sweep(const SweepArgs& args) {
     const auto r = confidence_factor(scene, run.bounds, cf, args.threads);
     // Collapsed intervals and the mean width of the bisected joints' intervals.
     CaseEval stats;
-    width_stats(scene, run.bounds, 0.0, stats);
+    width_stats(scene, p.bounds, run.bounds, 0.0, stats);
     const int collapsed = stats.collapsed, bisected = stats.bisected;
     const double width = stats.mean_width;
     md << std::fixed << "| " << c << " | " << run.volume.boxes.size() << " | " << std::setprecision(1)

@@ -23,6 +23,7 @@ struct SweepArgs {
   std::string params;                    //!< parameter file (JSON)
   std::string preset = "leeway";         //!< parameter set
   std::string safety;                    //!< safety mode; empty: the preset's
+  JointBoundsOptions joints;             //!< --bisect, --half-width
   std::string csv;                       //!< CSV file to write too; empty: none
   std::string plot;                      //!< sweep plot to write (.svg or .png); empty: none
   int threads = default_threads();       //!< worker threads

@@ -1,0 +1,199 @@
+// Growth beyond the guide in the certified mode: on hand-worked arms the grown bound reaches the
+// analytic touch angle less the margin, never more; caps and joint choices are kept; every grown
+// region is free when sampled densely.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+
+#include "leeway/kinematics.hpp"
+#include "leeway/safety.hpp"
+#include "test_util.hpp"
+
+namespace leeway {
+namespace {
+
+using ::testing::HasSubstr;
+
+// One-link arm (test_util.hpp) and the wall y >= 0.95: the link's corner (1, 0.05) touches it at
+// t = asin(0.95 / sqrt(1.0025)) - atan(0.05) = 1.19950 rad and comes within 1 mm of it
+// 0.001 / (cos t - 0.05 sin t) = 0.00316 rad earlier. Its range is [-3, 3]; nothing is on the -y side.
+const char* kWall = R"(<geom name="wall" type="box" size="1 0.05 1" pos="0 1 1"/>)";
+const double kTouch = std::asin(0.95 / std::sqrt(1.0025)) - std::atan(0.05);
+const double kWithinMargin = 0.001 / (std::cos(kTouch) - 0.05 * std::sin(kTouch));
+
+// A two-link planar arm: j1 about z at (0, 0, 0.5) with a 1 m link along x, j2 about z at its tip
+// with a 0.5 m link (box half-size 0.25 x 0.05 x 0.05), ranges [-2.5, 2.5]; a wall whose near face is
+// the plane y = 0.45 over x in [0.75, 1.75]. With j1 = 0, link 2's corner (0.5, 0.05) from j2 reaches
+// it at 0.5 sin t + 0.05 cos t = 0.45: t2 = asin(0.45 / sqrt(0.2525)) - atan(0.1) = 1.01052 rad, and
+// comes within 1 mm 0.001 / (0.5 cos t2 - 0.05 sin t2) = 0.00449 rad earlier.
+const char* kTwoLink = R"(<mujoco model="two-link">
+  <compiler angle="radian" autolimits="true"/>
+  <worldbody>
+    <body name="base">
+      <geom name="base_box" type="box" size="0.1 0.1 0.25" pos="0 0 0.25"/>
+      <body name="link1" pos="0 0 0.5">
+        <joint name="j1" type="hinge" axis="0 0 1" range="-2.5 2.5" user="1.5"/>
+        <geom name="link1_box" type="box" size="0.5 0.05 0.05" pos="0.5 0 0"/>
+        <body name="link2" pos="1 0 0">
+          <joint name="j2" type="hinge" axis="0 0 1" range="-2.5 2.5" user="1.5"/>
+          <geom name="link2_box" type="box" size="0.25 0.05 0.05" pos="0.25 0 0"/>
+          <site name="tool0" pos="0.5 0 0"/>
+        </body>
+      </body>
+    </body>
+    <geom name="wall" type="box" size="0.5 0.05 1" pos="1.25 0.5 1"/>
+  </worldbody>
+</mujoco>
+)";
+const double kTouch2 = std::asin(0.45 / std::sqrt(0.2525)) - std::atan(0.1);
+const double kWithinMargin2 = 0.001 / (0.5 * std::cos(kTouch2) - 0.05 * std::sin(kTouch2));
+
+WaypointBounds box(const Eigen::VectorXd& q, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper) {
+  return WaypointBounds(q, lower, upper);
+}
+Eigen::VectorXd v1(double a) { return Eigen::VectorXd::Constant(1, a); }
+Eigen::VectorXd v2(double a, double b) { return (Eigen::VectorXd(2) << a, b).finished(); }
+
+// The smallest exact clearance over the segments' regions: corners of every end box and `samples`
+// seeded configurations per segment (t uniform, each joint at a bound or uniform in between).
+double sampled_clearance(const Scene& scene, const std::vector<WaypointBounds>& b, int samples) {
+  RobotState state(scene);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(0, 1);
+  double best = INFINITY;
+  const int n = scene.dof();
+  for (const auto& w : b)
+    for (int c = 0; c < (1 << n); ++c) {
+      Eigen::VectorXd q(n);
+      for (int i = 0; i < n; ++i) q[i] = (c >> i) & 1 ? w.upper[i] : w.lower[i];
+      best = std::min(best, state.clearance(q).distance);
+    }
+  for (size_t s = 0; s + 1 < std::max<size_t>(2, b.size()); ++s) {
+    const WaypointBounds& a = b[s];
+    const WaypointBounds& e = b[std::min(s + 1, b.size() - 1)];
+    for (int k = 0; k < samples; ++k) {
+      const double t = u(rng);
+      Eigen::VectorXd q(n);
+      for (int i = 0; i < n; ++i) {
+        const double lo = (1 - t) * a.lower[i] + t * e.lower[i], hi = (1 - t) * a.upper[i] + t * e.upper[i];
+        const double pick = u(rng);
+        q[i] = pick < 0.25 ? lo : pick < 0.5 ? hi : lo + (hi - lo) * u(rng);
+      }
+      best = std::min(best, state.clearance(q).distance);
+    }
+  }
+  return best;
+}
+
+class GrowTest : public ::testing::Test {
+ protected:
+  test::TempDir dir_;
+};
+
+TEST_F(GrowTest, OneLinkGrowsToTheWallLessTheMarginAndToTheLimitOnTheFreeSide) {
+  const Scene scene = Scene::load(dir_.write("one_link.xml", test::one_link_cell(kWall)));
+  // A narrow guide the certificate accepts at once: only growth can widen it.
+  std::vector<WaypointBounds> b = {box(v1(0.0), v1(-0.1), v1(0.1)), box(v1(0.3), v1(0.2), v1(0.4))};
+  const SafetyReport r = make_safe(scene, b, SafetyParams{});
+  ASSERT_TRUE(r.all_passed);
+  EXPECT_TRUE(r.grow.ran);
+  EXPECT_EQ(r.grow.grown, 2);
+  for (const auto& w : b) {
+    EXPECT_LE(w.upper[0], kTouch - kWithinMargin + 1e-9);
+    EXPECT_GE(w.upper[0], kTouch - kWithinMargin - 0.005);
+    EXPECT_NEAR(w.lower[0], -3.0, 0.005);
+  }
+  EXPECT_GE(sampled_clearance(scene, b, 20000), 0.001 - 1e-9);
+}
+
+TEST_F(GrowTest, TwoLinkElbowGrowsToItsTouchLessTheMarginWhenOnlyItGrows) {
+  const Scene scene = Scene::load(dir_.write("two_link.xml", kTwoLink));
+  // One waypoint; j1 held at its nominal value (a zero-width interval) and not grown.
+  std::vector<WaypointBounds> b = {box(v2(0, 0), v2(0, -0.1), v2(0, 0.1))};
+  SafetyParams params;
+  params.grow = "j2";
+  const SafetyReport r = make_safe(scene, b, params);
+  ASSERT_TRUE(r.all_passed);
+  EXPECT_EQ(b[0].lower[0], 0.0);
+  EXPECT_EQ(b[0].upper[0], 0.0);
+  EXPECT_LE(b[0].upper[1], kTouch2 - kWithinMargin2 + 1e-9);
+  EXPECT_GE(b[0].upper[1], kTouch2 - kWithinMargin2 - 0.005);
+  EXPECT_NEAR(b[0].lower[1], -2.5, 0.005);
+  EXPECT_GE(sampled_clearance(scene, b, 20000), 0.001 - 1e-9);
+}
+
+TEST_F(GrowTest, TwoLinkGrowingBothJointsStaysFree) {
+  const Scene scene = Scene::load(dir_.write("two_link.xml", kTwoLink));
+  std::vector<WaypointBounds> b = {box(v2(0, 0), v2(-0.05, -0.05), v2(0.05, 0.05)),
+                                   box(v2(-0.3, 0.4), v2(-0.35, 0.35), v2(-0.25, 0.45))};
+  const SafetyReport r = make_safe(scene, b, SafetyParams{});
+  ASSERT_TRUE(r.all_passed);
+  EXPECT_GT(r.grow.grown, 0);
+  // Both joints widened somewhere, and the region is free with the margin.
+  EXPECT_GT(b[0].upper[0] - b[0].lower[0], 0.1 + 1e-3);
+  EXPECT_GT(b[1].upper[1] - b[1].lower[1], 0.1 + 1e-3);
+  EXPECT_GE(sampled_clearance(scene, b, 50000), 0.001 - 1e-9);
+}
+
+TEST_F(GrowTest, CapsNarrowAndNoneKeepsTheCertifiedBounds) {
+  const Scene scene = Scene::load(dir_.write("one_link.xml", test::one_link_cell(kWall)));
+  const std::vector<WaypointBounds> guide = {box(v1(0.0), v1(-0.4), v1(0.4)), box(v1(0.3), v1(0.2), v1(0.4))};
+  SafetyParams capped;
+  capped.max_half_width = {{"j1", 0.25}};
+  std::vector<WaypointBounds> b = guide;
+  make_safe(scene, b, capped);
+  EXPECT_DOUBLE_EQ(b[0].lower[0], -0.25);
+  EXPECT_DOUBLE_EQ(b[0].upper[0], 0.25);
+  EXPECT_DOUBLE_EQ(b[1].lower[0], 0.3 - 0.25);
+  EXPECT_DOUBLE_EQ(b[1].upper[0], 0.3 + 0.25);
+  SafetyParams none;
+  none.grow = "none";
+  b = guide;
+  const SafetyReport r = make_safe(scene, b, none);
+  EXPECT_FALSE(r.grow.ran);
+  for (size_t k = 0; k < b.size(); ++k) {
+    EXPECT_EQ(b[k].lower[0], guide[k].lower[0]);
+    EXPECT_EQ(b[k].upper[0], guide[k].upper[0]);
+  }
+}
+
+TEST_F(GrowTest, GrowthDoesNotDependOnTheThreadCount) {
+  const Scene scene = Scene::load(dir_.write("two_link.xml", kTwoLink));
+  std::vector<WaypointBounds> one = {box(v2(0, 0), v2(-0.05, -0.05), v2(0.05, 0.05)),
+                                     box(v2(-0.2, 0.2), v2(-0.25, 0.15), v2(-0.15, 0.25)),
+                                     box(v2(-0.4, 0.4), v2(-0.45, 0.35), v2(-0.35, 0.45))};
+  std::vector<WaypointBounds> two = one;
+  make_safe(scene, one, SafetyParams{}, CertifyBound::kTaylor, 1);
+  make_safe(scene, two, SafetyParams{}, CertifyBound::kTaylor, 2);
+  for (size_t k = 0; k < one.size(); ++k) {
+    EXPECT_EQ(one[k].lower, two[k].lower);
+    EXPECT_EQ(one[k].upper, two[k].upper);
+  }
+}
+
+TEST_F(GrowTest, UnknownJointsAreRefusedNamingThem) {
+  const Scene scene = Scene::load(dir_.write("one_link.xml", test::one_link_cell(kWall)));
+  std::vector<WaypointBounds> b = {box(v1(0.0), v1(-0.1), v1(0.1))};
+  SafetyParams params;
+  params.grow = "j1,elbow";
+  try {
+    make_safe(scene, b, params);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("'safety.grow' = 'j1,elbow' names joint 'elbow'"));
+  }
+  params.grow = "all";
+  params.max_half_width = {{"wrist", 0.1}};
+  try {
+    make_safe(scene, b, params);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("'safety.max_half_width' names joint 'wrist'"));
+  }
+}
+
+}  // namespace
+}  // namespace leeway

@@ -94,9 +94,11 @@ nlohmann::json safety_json(const Scene& scene, const SafetyReport& report, const
                     {"excluded", excluded}};
     // Growth beyond the guide (docs/algorithm.md, "Growing beyond the guide"); its leaves are in
     // `leaves` above too.
-    out["grow"] = {
-        {"joints", params.grow},      {"max_half_width", params.max_half_width}, {"ran", report.grow.ran},
-        {"grown", report.grow.grown}, {"leaves", report.grow.stats.leaves},      {"ms", report.grow.ms}};
+    out["grow"] = {{"joints", params.grow},
+                   {"max_half_width", params.max_half_width},
+                   {"ran", report.grow.ran},
+                   {"grown", report.grow.grown},
+                   {"leaves", report.grow.stats.leaves}};
   } else if (report.mode == SafetyMode::kSampled) {
     out["passed"] = report.all_passed;
     out["epsilon"] = params.epsilon;
@@ -224,8 +226,7 @@ nlohmann::json room_json(const Scene& scene, const RoomReport& room, const RoomO
           {"seed", options.seed},
           {"joint_share", shares},
           {"mean_share", number(room.mean_share)},
-          {"waypoints", wps},
-          {"ms", room.ms}};
+          {"waypoints", wps}};
 }
 
 namespace {

@@ -73,16 +73,16 @@ class WaypointGrowth {
     // A thin slab first, on a small budget: when it cannot be proven, the thicker ones cannot
     // either, almost always, and a failing slab costs its whole budget.
     const double thin = extent + (candidate - extent) / 8;
-    if (!slab_free(i, side, extent, thin, slab_leaves_ / kThinSlabDivisor)) return true;
+    if (!slab_free(i, side, thin, slab_leaves_ / kThinSlabDivisor)) return true;
     set(i, side, thin);
-    if (slab_free(i, side, thin, candidate, slab_leaves_)) {
+    if (slab_free(i, side, candidate, slab_leaves_)) {
       set(i, side, candidate);
       return limited;
     }
     double ok = thin, bad = candidate;
     for (int step = 0; step < kCertifySteps; ++step) {
       const double mid = (ok + bad) / 2;
-      if (slab_free(i, side, ok, mid, slab_leaves_ / 2)) {
+      if (slab_free(i, side, mid, slab_leaves_ / 2)) {
         set(i, side, mid);
         ok = mid;
       } else {
@@ -104,7 +104,8 @@ class WaypointGrowth {
  private:
   // The probe (Certifier::segment_probe) of every segment at this waypoint with the extent set.
   bool probe(int i, int side, double extent) {
-    const double kept = current(i, side);
+    double& bound = side ? b_[k_].upper[i] : b_[k_].lower[i];
+    const double kept = bound;  // restored exactly: q -+ (q -+ bound) may differ from it in the last bit
     set(i, side, extent);
     bool free = true;
     for (const auto& [p, r] : segments_) {
@@ -112,15 +113,16 @@ class WaypointGrowth {
                                       kProbeSamples, stats_);
       if (!free) break;
     }
-    set(i, side, kept);
+    bound = kept;
     return free;
   }
 
-  // Widening the extent from `from` to `to` adds to each certified segment at this waypoint the
-  // configurations whose joint i lies between the old and the new bound: at each t a box, linear
-  // in t, of zero width at the segment's other end. Only the pairs joint i moves need a proof
-  // there (Certifier::segment_free's grown_joint).
-  bool slab_free(int i, int side, double from, double to, long leaves) {
+  // Widening the extent from the current bound to `to` adds to each certified segment at this
+  // waypoint the configurations whose joint i lies between the old and the new bound: at each t a
+  // box, linear in t, of zero width at the segment's other end. Only the pairs joint i moves need a
+  // proof there (Certifier::segment_free's grown_joint). The old bounds are taken as they are, to
+  // the last bit, and the new one is what set() writes.
+  bool slab_free(int i, int side, double to, long leaves) {
     const CertifyOptions normal = certifier_.options();
     CertifyOptions slab = normal;
     slab.max_leaves = std::max(64L, leaves);
@@ -129,12 +131,11 @@ class WaypointGrowth {
     for (const auto& [p, r] : segments_) {
       Eigen::VectorXd lo[2] = {b_[p].lower, b_[r].lower}, hi[2] = {b_[p].upper, b_[r].upper};
       for (int end = 0; end < 2; ++end) {
-        const size_t x = end ? r : p;
-        const WaypointBounds& w = b_[x];
-        const double now = side ? w.upper[i] - w.q[i] : w.q[i] - w.lower[i];
-        const double old_extent = x == k_ ? from : now, new_extent = x == k_ ? to : now;
-        lo[end][i] = side ? w.q[i] + old_extent : w.q[i] - new_extent;
-        hi[end][i] = side ? w.q[i] + new_extent : w.q[i] - old_extent;
+        const WaypointBounds& w = b_[end ? r : p];
+        const double old_bound = side ? w.upper[i] : w.lower[i];
+        const double new_bound = (end ? r : p) != k_ ? old_bound : side ? w.q[i] + to : w.q[i] - to;
+        lo[end][i] = side ? old_bound : new_bound;
+        hi[end][i] = side ? new_bound : old_bound;
       }
       free = certifier_.segment_free(lo[0], hi[0], lo[1], hi[1], stats_, nullptr, nullptr, i);
       if (!free) break;

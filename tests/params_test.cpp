@@ -79,6 +79,8 @@ Params unusual() {
   p.bounds.linear_axis_tolerance = 0.05;
   p.bounds.bisect = {"j4", "j1", "j2"};  // any order: bounded in model order
   p.bounds.half_width = {{"j5", 0.35}, {"rail_x", 0.5}};
+  p.safety.grow = "j4,j6";
+  p.safety.max_half_width = {{"j6", 0.25}};
   p.cf.windows = 12;
   p.cf.samples = 500;
   p.cf.seed = 18446744073709551615ull;  // the largest seed: JSON must carry all 64 bits
@@ -113,6 +115,8 @@ void expect_equal(const Params& a, const Params& b) {
   EXPECT_EQ(a.bounds.linear_axis_tolerance, b.bounds.linear_axis_tolerance);
   EXPECT_EQ(a.bounds.bisect, b.bounds.bisect);
   EXPECT_EQ(a.bounds.half_width, b.bounds.half_width);
+  EXPECT_EQ(a.safety.grow, b.safety.grow);
+  EXPECT_EQ(a.safety.max_half_width, b.safety.max_half_width);
   EXPECT_EQ(a.cf.windows, b.cf.windows);
   EXPECT_EQ(a.cf.samples, b.cf.samples);
   EXPECT_EQ(a.cf.seed, b.cf.seed);
@@ -137,7 +141,7 @@ TEST(ParamsJsonTest, KeysAreTheFieldNames) {
   EXPECT_EQ(j.at("bounds").at("linear_axis_tolerance"), 0.05);
   EXPECT_EQ(j.at("cf").at("seed"), 18446744073709551615ull);
   EXPECT_EQ(j.size(), 6u);
-  EXPECT_EQ(j.at("safety").size(), 6u);
+  EXPECT_EQ(j.at("safety").size(), 8u);
   EXPECT_EQ(j.at("safety").at("mode"), "certified");
   EXPECT_EQ(j.at("height_map").size(), 6u);
   EXPECT_EQ(j.at("volume").size(), 14u);  // 13 of section 4.1 and 3.2 plus trail_margin

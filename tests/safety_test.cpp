@@ -64,8 +64,11 @@ TEST_F(OneLinkSafetyTest, HandComputedTouchAngle) {
 
 TEST_F(OneLinkSafetyTest, CertifiedShrinksOnlyTheSideThatHitsTheWall) {
   // Guide [-0.5, 2.0] around 0: the upper side reaches through the wall, the lower side is free.
+  // (Growth beyond the guide off: this is the shrink and the regrow; GrowTest has the growth.)
   std::vector<WaypointBounds> bounds = {box_around(0.0, -0.5, 2.0), box_around(0.3, -0.2, 2.0)};
-  const SafetyReport r = make_safe(*scene_, bounds, SafetyParams{});
+  SafetyParams params;
+  params.grow = "none";
+  const SafetyReport r = make_safe(*scene_, bounds, params);
   ASSERT_EQ(r.segments.size(), 1u);
   EXPECT_TRUE(r.all_passed);
   EXPECT_TRUE(r.segments[0].passed);
@@ -299,14 +302,31 @@ TEST_F(CliSafetyTest, CertifiedBoundsScoreNoCollisionOnTheThreeCells) {
     EXPECT_EQ(cf.at("samples").get<long>(), 300000);
     EXPECT_EQ(cf.at("collisions").get<long>(), 0);
     EXPECT_EQ(cf.at("cf").get<double>(), 1.0);
-    // Shrunk intervals lie within the guide and keep the nominal value.
+    // Every interval keeps the nominal value; a side lies within the guide unless the file records
+    // that growth widened it, and then by exactly what it records.
+    int grown = 0;
     for (const auto& w : j.at("waypoints"))
       for (size_t i = 0; i < w.at("q").size(); ++i) {
-        EXPECT_GE(w.at("lower")[i].get<double>(), w.at("guide_lower")[i].get<double>());
-        EXPECT_LE(w.at("upper")[i].get<double>(), w.at("guide_upper")[i].get<double>());
-        EXPECT_LE(w.at("lower")[i].get<double>(), w.at("q")[i].get<double>());
-        EXPECT_GE(w.at("upper")[i].get<double>(), w.at("q")[i].get<double>());
+        const std::string name = j.at("joints")[i];
+        const json by = w.at("grown").value(name, json{{"lower_by", 0.0}, {"upper_by", 0.0}});
+        const double lower = w.at("lower")[i], upper = w.at("upper")[i];
+        const double guide_lower = w.at("guide_lower")[i], guide_upper = w.at("guide_upper")[i];
+        if (by.at("lower_by").get<double>() > 0) {
+          EXPECT_NEAR(lower, guide_lower - by.at("lower_by").get<double>(), 1e-12);
+          ++grown;
+        } else {
+          EXPECT_GE(lower, guide_lower);
+        }
+        if (by.at("upper_by").get<double>() > 0) {
+          EXPECT_NEAR(upper, guide_upper + by.at("upper_by").get<double>(), 1e-12);
+          ++grown;
+        } else {
+          EXPECT_LE(upper, guide_upper);
+        }
+        EXPECT_LE(lower, w.at("q")[i].get<double>());
+        EXPECT_GE(upper, w.at("q")[i].get<double>());
       }
+    EXPECT_GT(grown, 0);  // the growth beyond the guide is part of what cf judged
   }
 }
 

@@ -10,8 +10,8 @@ rebuilds docs/results.md from them without running anything. The sweep plots it 
 Runs `leeway sweep --preset thesis` (no safety stage: the published method) for every (cell, path)
 in two configurations: the thesis's parameters (section 4.1, with each cell's own reach radius and
 the DLR obstacle-box option) and the same with volume.trail_margin = 0.1 m. Takes several minutes
-on 2 cores. The section on the safety stage comes from tools/make_safety_results.py, the closed loop's from
-tools/make_simulate_results.py.
+on 2 cores. The section on the safety stage comes from tools/make_safety_results.py, the room's from
+tools/make_room_results.py, the closed loop's from tools/make_simulate_results.py.
 """
 import argparse
 import csv
@@ -131,6 +131,10 @@ def main():
     self_collision = ROOT / "docs" / "data" / "safety" / "self_collision.md"
     if self_collision.exists():
         o.append(self_collision.read_text())
+    # The room the bounds keep, before and after growth: tools/make_room_results.py writes this section.
+    room = ROOT / "docs" / "data" / "room" / "section.md"
+    if room.exists():
+        o.append(room.read_text())
     # The closed loop: tools/make_simulate_results.py writes this section.
     simulate = ROOT / "docs" / "data" / "simulate" / "section.md"
     if simulate.exists():

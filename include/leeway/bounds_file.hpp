@@ -40,7 +40,7 @@ nlohmann::json bounds_json(const Scene& scene, const BoundsRun& run, const Param
 
 //! The room record of a bounds file (docs/algorithm.md, "Room"): what the measure is, per joint the
 //! share of its one-joint free range kept (names as keys), their mean, and per waypoint the free
-//! ranges, the shares and the tool's room. An undefined share is null.
+//! ranges, the shares and the tool's room. An undefined share is null. (Its time goes to timing_ms.)
 nlohmann::json room_json(const Scene& scene, const RoomReport& room, const RoomOptions& options);
 
 //! Reads a bounds file written for `scene`: q, lower, upper and collapsed of every waypoint (the

@@ -303,6 +303,7 @@ int run_bounds(const BoundsArgs& args) {
   if (args.room == "on" || (args.room.empty() && args.preset != "thesis")) {
     room = measure_room(scene, run.bounds, room_options, args.threads);
     out["room"] = room_json(scene, *room, room_options);
+    out["timing_ms"]["room"] = room->ms;
   }
   // The exports first: the MJB compiles the model and may fail; then nothing else is written.
   std::string mjcf, mjb;

@@ -531,31 +531,9 @@ TEST_F(BoundsSceneTest, RejectsNominalsOutsideTheLimitsOrOfTheWrongSize) {
 // near face is the plane x = 0.25 (x 0.25 .. 0.35, y -1 .. 1, z 0.5 .. 2.5). Keyframes: a (straight
 // up) and b (j1 = 0.3, j2 = -0.2: turned, and tilted away from the wall).
 std::string chain_cell(int n) {
-  const double seg = 1.6 / n;
-  std::string bodies, closing, straight, bent;
-  for (int i = 0; i < n; ++i) {
-    bodies += "<body name=\"l" + std::to_string(i + 1) + "\" pos=\"0 0 " +
-              (i == 0 ? "0.2" : std::to_string(seg)) + "\"><joint name=\"j" + std::to_string(i + 1) +
-              "\" type=\"hinge\" axis=\"" + (i % 2 ? "0 1 0" : "0 0 1") +
-              "\" range=\"-1.5 1.5\" user=\"1.5\"/><geom name=\"g" + std::to_string(i + 1) +
-              "\" type=\"box\" size=\"0.03 0.03 " + std::to_string(0.4 * seg) + "\" pos=\"0 0 " +
-              std::to_string(0.5 * seg) + "\"/>\n";
-    closing += "</body>";
-    straight += " 0";
-    bent += i == 0 ? " 0.3" : i == 1 ? " -0.2" : " 0";
-  }
-  return R"(<mujoco model="chain">
-  <compiler angle="radian" autolimits="true"/>
-  <worldbody>
-    <body name="base"><geom name="base_box" type="box" size="0.1 0.1 0.1" pos="0 0 0.1"/>
-)" + bodies +
-         "<site name=\"tool0\" pos=\"0 0 " + std::to_string(seg) + "\"/>" + closing + R"(</body>
-    <geom name="wall" type="box" size="0.05 1 1" pos="0.3 0 1.5" contype="0" conaffinity="1"/>
-  </worldbody>
-  <keyframe><key name="a" qpos=")" +
-         straight.substr(1) + R"("/><key name="b" qpos=")" + bent.substr(1) + R"("/></keyframe>
-</mujoco>
-)";
+  return test::serial_chain_cell(n, "-1.5 1.5", "0.3 0 1.5", [](int i) {
+    return i == 0 ? "0.3" : i == 1 ? "-0.2" : "0";
+  });
 }
 
 BoundsParams bisecting(std::vector<std::string> joints) {

@@ -141,31 +141,7 @@ TEST_F(OneLinkSafetyTest, ADensePathWidensAgainWhereItsGuideWidens) {
 // base, as tools/chain_cell.py writes it, with a wall 0.85 m to its side; keyframes a (straight)
 // and b (bent).
 std::string chain_cell(int n) {
-  const double seg = 1.6 / n;
-  std::string bodies, closing, straight, bent;
-  for (int i = 0; i < n; ++i) {
-    bodies += "<body name=\"l" + std::to_string(i + 1) + "\" pos=\"0 0 " +
-              (i == 0 ? "0.2" : std::to_string(seg)) + "\"><joint name=\"j" + std::to_string(i + 1) +
-              "\" type=\"hinge\" axis=\"" + (i % 2 ? "0 1 0" : "0 0 1") +
-              "\" range=\"-3 3\" user=\"1.5\"/><geom name=\"g" + std::to_string(i + 1) +
-              "\" type=\"box\" size=\"0.03 0.03 " + std::to_string(0.4 * seg) + "\" pos=\"0 0 " +
-              std::to_string(0.5 * seg) + "\"/>\n";
-    closing += "</body>";
-    straight += " 0";
-    bent += i % 2 ? " 0.02" : " 0";
-  }
-  return R"(<mujoco model="chain">
-  <compiler angle="radian" autolimits="true"/>
-  <worldbody>
-    <body name="base"><geom name="base_box" type="box" size="0.1 0.1 0.1" pos="0 0 0.1"/>
-)" + bodies +
-         "<site name=\"tool0\" pos=\"0 0 " + std::to_string(seg) + "\"/>" + closing + R"(</body>
-    <geom name="wall" type="box" size="0.05 1 1" pos="0.9 0 1" contype="0" conaffinity="1"/>
-  </worldbody>
-  <keyframe><key name="a" qpos=")" +
-         straight.substr(1) + R"("/><key name="b" qpos=")" + bent.substr(1) + R"("/></keyframe>
-</mujoco>
-)";
+  return test::serial_chain_cell(n, "-3 3", "0.9 0 1", [](int i) { return i % 2 ? "0.02" : "0"; });
 }
 
 TEST(SafetyBudgetTest, ALongChainStopsAtTheSegmentBudgetAndIsNotCertified) {

@@ -144,6 +144,40 @@ inline nlohmann::json read_json(const std::filesystem::path& p) {
   return nlohmann::json::parse(in);
 }
 
+//! A serial chain of n hinges as tools/chain_cell.py writes it: about z and y in turn, 1.6 m in all,
+//! a 6 cm box per link on a fixed base, every joint's range `range` ("-3 3") [rad], the wall geom
+//! (0.05 x 1 x 1 half-size) at `wall_pos` ("0.9 0 1"); keyframes a (every joint 0) and b (joint i at
+//! bent(i), its text as written into qpos).
+inline std::string serial_chain_cell(int n, const std::string& range, const std::string& wall_pos,
+                                     const std::function<std::string(int)>& bent_joint) {
+  const double seg = 1.6 / n;
+  std::string bodies, closing, straight, bent;
+  for (int i = 0; i < n; ++i) {
+    bodies += "<body name=\"l" + std::to_string(i + 1) + "\" pos=\"0 0 " +
+              (i == 0 ? "0.2" : std::to_string(seg)) + "\"><joint name=\"j" + std::to_string(i + 1) +
+              "\" type=\"hinge\" axis=\"" + (i % 2 ? "0 1 0" : "0 0 1") + "\" range=\"" + range +
+              "\" user=\"1.5\"/><geom name=\"g" + std::to_string(i + 1) +
+              "\" type=\"box\" size=\"0.03 0.03 " + std::to_string(0.4 * seg) + "\" pos=\"0 0 " +
+              std::to_string(0.5 * seg) + "\"/>\n";
+    closing += "</body>";
+    straight += " 0";
+    bent += " " + bent_joint(i);
+  }
+  return R"(<mujoco model="chain">
+  <compiler angle="radian" autolimits="true"/>
+  <worldbody>
+    <body name="base"><geom name="base_box" type="box" size="0.1 0.1 0.1" pos="0 0 0.1"/>
+)" + bodies +
+         "<site name=\"tool0\" pos=\"0 0 " + std::to_string(seg) + "\"/>" + closing + R"(</body>
+    <geom name="wall" type="box" size="0.05 1 1" pos=")" +
+         wall_pos + R"(" contype="0" conaffinity="1"/>
+  </worldbody>
+  <keyframe><key name="a" qpos=")" +
+         straight.substr(1) + R"("/><key name="b" qpos=")" + bent.substr(1) + R"("/></keyframe>
+</mujoco>
+)";
+}
+
 //! A one-link arm: hinge j1 about z at (0, 0, 0.5), a 1 m box link along +x (half-size
 //! 0.5 x 0.05 x 0.05), tool0 at its tip. `world` is inserted into the world body.
 inline std::string one_link_cell(const std::string& world, const std::string& keys = "") {

@@ -159,7 +159,7 @@ Bounds bounds_between(const std::shared_ptr<Scene>& scene_ptr, const std::string
     throw NominalCollision(scene.source() + ": the straight path from " + from + " to " + to + " " +
                            describe_collision(scene, *checked.collision, true) +
                            " (leeway bounds plans around it; bound a planned path there)");
-  VolumeModel world(scene, p.height_map.max_cells + static_cast<int>(scene.obstacle_geoms().size()));
+  VolumeModel world(scene, VolumeModel::capacity_for(scene, p.height_map.max_cells));
   const BoundsRun run = compute_bounds(scene, world, path, p, threads);
   Bounds b;
   b.joints = joint_names(scene);

@@ -47,8 +47,6 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-bool is_gripper(const std::string& spec) { return spec.rfind("site:", 0) == 0 || spec.rfind("xyz:", 0) == 0; }
-
 // Reads the fields of one scenario (or the defaults) for validation; every message starts with
 // `where` ("suite.json: scenario 2 'dallara-home-patch'") and names the field.
 class Fields {
@@ -199,10 +197,7 @@ Params scenario_params(const Scene& scene, const json& s) {
       p = read_params(s["params"].get<std::string>(), p);
   }
   if (s.contains("safety")) {
-    const auto mode = s["safety"].get<std::string>();
-    p.safety.mode = mode == "none"      ? SafetyMode::kNone
-                    : mode == "sampled" ? SafetyMode::kSampled
-                                        : SafetyMode::kCertified;
+    p.safety.mode = parse_safety_mode(s["safety"].get<std::string>(), "the scenario's safety");
   }
   if (s.contains("max_cells")) p.height_map.max_cells = s["max_cells"].get<int>();
   if (s.contains("cf")) {
@@ -282,8 +277,8 @@ Suite read_suite(const std::string& file) {
     if (!by_file && (!s.contains("from") || !s.contains("to")))
       f.fail(s.contains("from") ? "to" : "from",
              "is missing (give 'from' and 'to', or a path file in 'path')");
-    const bool linear =
-        !by_file && !is_gripper(s["from"].get<std::string>()) && !is_gripper(s["to"].get<std::string>());
+    const bool linear = !by_file && !is_gripper_goal(s["from"].get<std::string>()) &&
+                        !is_gripper_goal(s["to"].get<std::string>());
     if (s.contains("waypoints") && !linear)
       f.fail("waypoints", "applies to the joint-linear path between two keyframes only");
 
@@ -397,7 +392,7 @@ json run_scenario(const json& resolved, int threads) {
     const std::string from = s.value("from", std::string()), to = s.value("to", std::string());
     if (s.contains("path")) {
       path = read_path(s["path"].get<std::string>(), scene);
-    } else if (!is_gripper(from) && !is_gripper(to)) {
+    } else if (!is_gripper_goal(from) && !is_gripper_goal(to)) {
       path = keyframe_path(scene, from, to, s.value("waypoints", 2));
       if (const auto hit = check_path(scene, path); !hit.free()) {
         PlanOptions around = plan;
@@ -434,7 +429,7 @@ json run_scenario(const json& resolved, int threads) {
     measured["waypoints"] = path.size();
     measured["planned"] = planned;
 
-    VolumeModel world(scene, p.height_map.max_cells + static_cast<int>(scene.obstacle_geoms().size()));
+    VolumeModel world(scene, VolumeModel::capacity_for(scene, p.height_map.max_cells));
     const BoundsRun run = compute_bounds(scene, world, path, p, threads);
     const auto c0 = Clock::now();
     const CfResult cf = confidence_factor(scene, run.bounds, p.cf, threads);

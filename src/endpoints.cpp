@@ -51,6 +51,10 @@ Eigen::Vector3d site_position(const Scene& scene, const std::string& name) {
   return state.site_pose(site).position;
 }
 
+bool is_gripper_goal(const std::string& spec) {
+  return spec.rfind("site:", 0) == 0 || spec.rfind("xyz:", 0) == 0;
+}
+
 std::pair<Endpoint, Endpoint> resolve_endpoints(const Scene& scene, const std::string& from,
                                                 const std::string& to, const EndpointOptions& options) {
   auto parse = [&](const std::string& spec) {

@@ -286,6 +286,12 @@ const char* safety_mode_name(SafetyMode mode) {
   return "?";
 }
 
+SafetyMode parse_safety_mode(const std::string& name, const std::string& what) {
+  for (SafetyMode m : {SafetyMode::kNone, SafetyMode::kSampled, SafetyMode::kCertified})
+    if (name == safety_mode_name(m)) return m;
+  throw InputError(what + " '" + name + "' must be certified, sampled or none");
+}
+
 Params preset_params(const std::string& name) {
   Params p;
   if (name == "thesis") {

@@ -198,14 +198,14 @@ RoomReport measure_room(const Scene& scene, const std::vector<WaypointBounds>& b
   int defined = 0;
   for (int i = 0; i < n; ++i) {
     double joint_sum = 0;
-    int count = 0;
+    int waypoints = 0;
     for (const auto& room : report.waypoints)
       if (!std::isnan(room.share[i])) {
         joint_sum += room.share[i];
-        ++count;
+        ++waypoints;
       }
-    if (count == 0) continue;
-    report.joint_share[i] = joint_sum / count;
+    if (waypoints == 0) continue;
+    report.joint_share[i] = joint_sum / waypoints;
     sum += report.joint_share[i];
     ++defined;
   }

@@ -78,8 +78,7 @@ TuningCase::TuningCase(const CaseSpec& spec, const nlohmann::json& base_json, in
     apply_cell_defaults(*scene_, params_);
     if (!base_json.is_null()) params_ = params_from_json(base_json, "the base parameters", params_);
     params_.validate();
-    world_ = std::make_unique<VolumeModel>(*scene_,
-                                           pool_capacity + static_cast<int>(scene_->obstacle_geoms().size()));
+    world_ = std::make_unique<VolumeModel>(*scene_, VolumeModel::capacity_for(*scene_, pool_capacity));
   } catch (const InputError& e) {
     throw InputError(what + ": " + e.what());
   }

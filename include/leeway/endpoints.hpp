@@ -44,6 +44,9 @@ struct Endpoint {
   IkResult ik;                                         //!< the IK result (sites and points only)
 };
 
+//! True when `spec` names a gripper goal ("site:NAME" or "xyz:X,Y,Z") rather than a keyframe.
+bool is_gripper_goal(const std::string& spec);
+
 //! Options of resolve_endpoints().
 struct EndpointOptions {
   std::string ik_seed_key;  //!< keyframe seeding every IK; "" = the policy of resolve_endpoints()

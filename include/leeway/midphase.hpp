@@ -27,7 +27,7 @@ inline bool overlaps(const Aabb& a, const Aabb& b, double tolerance) {
 //! A static set of axis-aligned boxes indexed for overlap queries. Boxes whose footprint is at most
 //! twice the grid's cell side are bucketed by their centre; larger ones (a big obstacle among small
 //! volume boxes) are kept in a list that every query scans. Every query returns exactly the boxes
-//! whose AABB overlaps the query's within the tolerance (tested, tests/midphase_test.cpp), in
+//! whose AABB overlaps the query's within the tolerance (AabbGridTest in tests/collision_test.cpp), in
 //! increasing index order within a bucket.
 class AabbGrid {
  public:

@@ -153,6 +153,10 @@ Params preset_params(const std::string& name);
 //! "none", "sampled" or "certified".
 const char* safety_mode_name(SafetyMode mode);
 
+//! The mode safety_mode_name() gives `name`. @throws InputError naming `what` (the flag, key or
+//! file that gave it) and the value when it is none of the three.
+SafetyMode parse_safety_mode(const std::string& name, const std::string& what);
+
 //! Parameters as JSON (every field, SI units in the key documentation).
 nlohmann::json to_json(const Params& p);
 //! Parameters from JSON: missing keys keep their defaults, unknown keys are an error.

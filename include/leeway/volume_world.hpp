@@ -35,6 +35,12 @@ class VolumeModel {
   enum class Growth { kBinary, kXml };
   VolumeModel(const Scene& scene, int capacity, Growth growth = Growth::kBinary);
 
+  //! The pool a volume of at most `max_cells` height-map cells needs: one box per cell, and one per
+  //! obstacle geom (volume.add_obstacle_boxes), so set_boxes() never has to grow it.
+  static int capacity_for(const Scene& scene, int max_cells) {
+    return max_cells + static_cast<int>(scene.obstacle_geoms().size());
+  }
+
   //! Puts the boxes into the pool (positions, orientations, sizes, bounding radii, bitmasks),
   //! shrinks the pool body's geom count to them so MuJoCo iterates only active boxes, and indexes
   //! them for the midphase. Grows the pool when it is too small. Not thread-safe: call it before

@@ -294,7 +294,7 @@ int run_bounds(const BoundsArgs& args) {
     return kExitFindings;
   }
   nominal["checks"] = checked.checks;
-  VolumeModel world(scene, p.height_map.max_cells + static_cast<int>(scene.obstacle_geoms().size()));
+  VolumeModel world(scene, VolumeModel::capacity_for(scene, p.height_map.max_cells));
   const auto run = compute_bounds(scene, world, path, p, args.threads);
   json out = bounds_json(scene, run, p);
   out["nominal_path"] = nominal;

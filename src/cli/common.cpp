@@ -161,21 +161,8 @@ Params load_params(const Scene& scene, const std::string& preset, const std::str
   Params p = preset_params(preset);
   apply_cell_defaults(scene, p);
   if (!file.empty()) p = read_params(file, p);
-  if (!safety.empty()) {
-    if (safety == "none")
-      p.safety.mode = SafetyMode::kNone;
-    else if (safety == "sampled")
-      p.safety.mode = SafetyMode::kSampled;
-    else if (safety == "certified")
-      p.safety.mode = SafetyMode::kCertified;
-    else
-      throw InputError("--safety '" + safety + "' must be certified, sampled or none");
-  }
+  if (!safety.empty()) p.safety.mode = parse_safety_mode(safety, "--safety");
   return p;
-}
-
-bool is_gripper_goal(const std::string& spec) {
-  return spec.rfind("site:", 0) == 0 || spec.rfind("xyz:", 0) == 0;
 }
 
 bool plan_between(const Scene& scene, const std::string& from, const std::string& to,

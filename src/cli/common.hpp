@@ -255,9 +255,6 @@ Eigen::VectorXd configuration(const Scene& scene, const std::string& q, const st
 Params load_params(const Scene& scene, const std::string& preset, const std::string& file,
                    const std::string& safety);
 
-//! Whether a path end needs inverse kinematics (and so a planned path) rather than a keyframe.
-bool is_gripper_goal(const std::string& spec);
-
 //! Plans between two path ends (docs/planning.md). On an unreachable goal or no path, prints the
 //! one-line reason and returns false: the caller exits with kExitFindings and writes nothing.
 bool plan_between(const Scene& scene, const std::string& from, const std::string& to,

@@ -154,7 +154,7 @@ int run_render(const RenderArgs& args) {
           << "; bound a planned path with leeway bounds --out and render it with --bounds; nothing written\n";
       return kExitFindings;
     }
-    VolumeModel world(scene, p.height_map.max_cells + static_cast<int>(scene.obstacle_geoms().size()));
+    VolumeModel world(scene, VolumeModel::capacity_for(scene, p.height_map.max_cells));
     BoundsRun run = compute_bounds(scene, world, path, p, args.threads);
     bounds = std::move(run.bounds);
     volume = std::move(run.volume);

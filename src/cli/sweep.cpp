@@ -121,8 +121,7 @@ int run_sweep(const SweepArgs& args) {
     p.height_map.max_cells = c;
     p.validate();
   }
-  VolumeModel world(
-      scene, *std::max_element(cells.begin(), cells.end()) + static_cast<int>(scene.obstacle_geoms().size()));
+  VolumeModel world(scene, VolumeModel::capacity_for(scene, *std::max_element(cells.begin(), cells.end())));
   if (csv_file.is_open()) csv_file.truncate();
   std::ostringstream no_csv;
   std::ostream& csv = csv_file.is_open() ? csv_file.stream() : no_csv;

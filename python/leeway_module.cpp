@@ -135,40 +135,36 @@ Bounds bounds_between(const std::shared_ptr<Scene>& scene_ptr, const std::string
   const json overrides = params_object(params);  // with the GIL: reads Python objects
   py::gil_scoped_release release;
   // As `leeway bounds`: the preset, the cell's own defaults, the parameters given, then safety.
-  Params p = preset_params(preset);
-  apply_cell_defaults(scene, p);
-  if (!overrides.empty()) p = params_from_json(overrides, "bounds() keyword parameters", p);
-  if (safety) {
-    if (*safety == "none")
-      p.safety.mode = SafetyMode::kNone;
-    else if (*safety == "sampled")
-      p.safety.mode = SafetyMode::kSampled;
-    else if (*safety == "certified")
-      p.safety.mode = SafetyMode::kCertified;
-    else
-      throw InputError("safety '" + *safety + "' must be certified, sampled or none");
+  ParamLayers layers;
+  layers.preset = preset;
+  if (!overrides.empty()) {
+    layers.object = overrides;
+    layers.object_source = "bounds() keyword parameters";
   }
+  if (safety) layers.safety = parse_safety_mode(*safety, "safety");
+  Params p = compose_params(scene, layers);
   p.validate();
   threads = resolve_threads(threads);
   if (waypoints < 2) throw InputError("waypoints " + std::to_string(waypoints) + " must be >= 2");
-  const auto path = keyframe_path(scene, from, to, waypoints);
-  // The method assumes a collision-free nominal path: it is checked densely first.
-  const PathCheckOptions check;
-  const PathCheckResult checked = check_path(scene, path, check);
-  if (!checked.free())
-    throw NominalCollision(scene.source() + ": the straight path from " + from + " to " + to + " " +
-                           describe_collision(scene, *checked.collision, true) +
-                           " (leeway bounds plans around it; bound a planned path there)");
+  // The method assumes a collision-free nominal path: it is checked densely first. Keyframes only,
+  // and no planning around a collision (leeway bounds does that).
+  if (is_gripper_goal(from) || is_gripper_goal(to))
+    throw InputError("bounds(): from and to must be keyframes, got '" + from + "' and '" + to + "'");
+  PathRequest request;
+  request.from = from;
+  request.to = to;
+  request.waypoints = waypoints;
+  request.plan_around = false;
+  const NominalPath nominal = resolve_nominal_path(scene, request);
+  if (!nominal.ok())
+    throw NominalCollision(nominal.message + " (leeway bounds plans around it; bound a planned path there)");
+  const std::vector<Eigen::VectorXd>& path = nominal.waypoints;
   VolumeModel world(scene, VolumeModel::capacity_for(scene, p.height_map.max_cells));
   const BoundsRun run = compute_bounds(scene, world, path, p, threads);
   Bounds b;
   b.joints = joint_names(scene);
   b.file = bounds_json(scene, run, p);
-  b.file["nominal_path"] = {{"checked", true},
-                            {"resolution", check.resolution},
-                            {"slide_resolution", check.slide_resolution},
-                            {"planned", false},
-                            {"checks", checked.checks}};
+  b.file["nominal_path"] = nominal.record;
   b.certified = proven(b.file);
   b.trajectory = std::make_shared<const BoundsTrajectory>(scene, run.bounds);
   return b;

@@ -188,17 +188,19 @@ void check_fields(const Fields& f, const json& s, bool is_defaults) {
 // The scenario's parameters, as `leeway bounds` builds them: the preset, the cell's own, the
 // parameter file or object, the safety mode, MAX_cells, then the CF settings.
 Params scenario_params(const Scene& scene, const json& s) {
-  Params p = preset_params(s.value("preset", std::string("leeway")));
-  apply_cell_defaults(scene, p);
+  ParamLayers layers;
+  layers.preset = s.value("preset", std::string("leeway"));
   if (s.contains("params")) {
-    if (s["params"].is_object())
-      p = params_from_json(s["params"], "the scenario's params", p);
-    else
-      p = read_params(s["params"].get<std::string>(), p);
+    if (s["params"].is_object()) {
+      layers.object = s["params"];
+      layers.object_source = "the scenario's params";
+    } else {
+      layers.file = s["params"].get<std::string>();
+    }
   }
-  if (s.contains("safety")) {
-    p.safety.mode = parse_safety_mode(s["safety"].get<std::string>(), "the scenario's safety");
-  }
+  if (s.contains("safety"))
+    layers.safety = parse_safety_mode(s["safety"].get<std::string>(), "the scenario's safety");
+  Params p = compose_params(scene, layers);
   if (s.contains("max_cells")) p.height_map.max_cells = s["max_cells"].get<int>();
   if (s.contains("cf")) {
     p.cf.windows = s["cf"].value("windows", p.cf.windows);
@@ -387,45 +389,17 @@ json run_scenario(const json& resolved, int threads) {
       plan.seed = s["plan"].value("seed", plan.seed);
       plan.time_limit = s["plan"].value("time_limit", plan.time_limit);
     }
-    std::vector<Eigen::VectorXd> path;
-    bool planned = false;
-    const std::string from = s.value("from", std::string()), to = s.value("to", std::string());
-    if (s.contains("path")) {
-      path = read_path(s["path"].get<std::string>(), scene);
-    } else if (!is_gripper_goal(from) && !is_gripper_goal(to)) {
-      path = keyframe_path(scene, from, to, s.value("waypoints", 2));
-      if (const auto hit = check_path(scene, path); !hit.free()) {
-        PlanOptions around = plan;
-        around.try_direct = false;
-        const PlanResult pr =
-            plan_path(scene, path.front(), path.back(), around, "start '" + from + "'", "goal '" + to + "'");
-        if (!pr.success)
-          throw InputError("no path: the straight path " + describe_collision(scene, *hit.collision, true) +
-                           "; " + pr.message);
-        path = pr.waypoints;
-        planned = true;
-      }
-    } else {
-      EndpointOptions eo;
-      eo.ik_seed_key = s.value("ik_seed", std::string());
-      const auto [a, b] = resolve_endpoints(scene, from, to, eo);
-      for (const Endpoint* e : {&a, &b})
-        if (!e->reachable)
-          throw InputError(
-              "unreachable: " + std::string(e == &a ? "start" : "goal") + " '" + e->spec + "' at (" +
-              format_number(e->position.x()) + ", " + format_number(e->position.y()) + ", " +
-              format_number(e->position.z()) +
-              ") m: no collision-free configuration with the tool pointing down within the joint "
-              "limits (closest: position error " +
-              format_number(e->ik.position_error) + " m)");
-      const PlanResult pr =
-          plan_path(scene, a.q, b.q, plan, "start '" + a.spec + "'", "goal '" + b.spec + "'");
-      if (!pr.success) throw InputError("no path: " + pr.message);
-      path = pr.waypoints;
-      planned = true;
-    }
-    if (const auto checked = check_path(scene, path); !checked.free())
-      throw InputError("collision: the path " + describe_collision(scene, *checked.collision));
+    PathRequest request;
+    request.file = s.value("path", std::string());
+    request.from = s.value("from", std::string());
+    request.to = s.value("to", std::string());
+    request.waypoints = s.value("waypoints", 2);
+    request.ik_seed = s.value("ik_seed", std::string());
+    request.plan = plan;
+    const NominalPath nominal = resolve_nominal_path(scene, request);
+    if (!nominal.ok()) throw InputError(std::string(refusal_name(nominal.refusal)) + ": " + nominal.message);
+    const std::vector<Eigen::VectorXd>& path = nominal.waypoints;
+    const bool planned = nominal.planned;
     measured["waypoints"] = path.size();
     measured["planned"] = planned;
 

@@ -34,4 +34,13 @@ void apply_cell_defaults(const Scene& scene, Params& params) {
   }
 }
 
+Params compose_params(const Scene& scene, const ParamLayers& layers) {
+  Params p = preset_params(layers.preset);
+  apply_cell_defaults(scene, p);
+  if (!layers.file.empty()) p = read_params(layers.file, p);
+  if (!layers.object.is_null()) p = params_from_json(layers.object, layers.object_source, p);
+  if (layers.safety) p.safety.mode = *layers.safety;
+  return p;
+}
+
 }  // namespace leeway

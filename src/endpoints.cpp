@@ -51,6 +51,16 @@ Eigen::Vector3d site_position(const Scene& scene, const std::string& name) {
   return state.site_pose(site).position;
 }
 
+std::string describe_unreachable(const Endpoint& end, bool start) {
+  return std::string(start ? "start" : "goal") + " '" + end.spec + "' at (" +
+         format_number(end.position.x()) + ", " + format_number(end.position.y()) + ", " +
+         format_number(end.position.z()) +
+         ") m: no collision-free configuration with the tool pointing down within the joint limits (closest: "
+         "position error " +
+         format_number(end.ik.position_error) + " m, orientation error " +
+         format_number(end.ik.orientation_error) + ")";
+}
+
 bool is_gripper_goal(const std::string& spec) {
   return spec.rfind("site:", 0) == 0 || spec.rfind("xyz:", 0) == 0;
 }

@@ -1,6 +1,7 @@
 #include "leeway/nominal_path.hpp"
 
 #include <cmath>
+#include <optional>
 
 #include <ompl/config.h>
 
@@ -122,6 +123,145 @@ std::vector<Eigen::VectorXd> read_path(const std::string& path, const Scene& sce
   } catch (const json::exception& e) {
     throw InputError(path + ": unexpected content: " + e.what());
   }
+}
+
+const char* refusal_name(PathRefusal refusal) {
+  switch (refusal) {
+    case PathRefusal::kNone:
+      return "";
+    case PathRefusal::kCollision:
+      return "collision";
+    case PathRefusal::kUnreachable:
+      return "unreachable";
+    case PathRefusal::kNoPath:
+      return "no path";
+  }
+  return "";
+}
+
+namespace {
+
+NominalPath refused(NominalPath out, PathRefusal refusal, std::string message) {
+  out.refusal = refusal;
+  out.message = std::move(message);
+  out.waypoints.clear();
+  return out;
+}
+
+// A straight path between two keyframes that collides: planned around unless the request says not
+// to or a keyframe is not free itself. Fills `out` with the planned path and the record of what it
+// replaced, or returns the refusal.
+std::optional<NominalPath> plan_around(const Scene& scene, const PathRequest& r,
+                                       const PathCheckResult& checked, std::vector<Eigen::VectorXd>& path,
+                                       NominalPath& out) {
+  const PathCollision hit = *checked.collision;
+  const std::string what =
+      "the straight path from " + r.from + " to " + r.to +
+      (path.size() > 2 ? " (" + std::to_string(path.size()) + " waypoints)" : std::string()) + " " +
+      describe_collision(scene, hit, true);
+  // A keyframe that is not free itself cannot be planned around.
+  std::string stuck;
+  for (const auto& [key, q] : {std::pair{r.from, path.front()}, std::pair{r.to, path.back()}})
+    if (stuck.empty() && !check_path(scene, {q}, r.check).free()) stuck = key;
+  if (!r.plan_around || !stuck.empty())
+    return refused(
+        out, PathRefusal::kCollision,
+        scene.source() + ": " + what +
+            (stuck.empty() ? "" : "; keyframe '" + stuck + "' itself is not free, so no path avoids it"));
+  PlanOptions around = r.plan;
+  around.try_direct = false;  // the straight edge may pass the planner's coarser check
+  const PlanResult planned =
+      plan_path(scene, path.front(), path.back(), around, "start '" + r.from + "'", "goal '" + r.to + "'");
+  if (!planned.success)
+    return refused(out, PathRefusal::kNoPath, scene.source() + ": " + what + "; " + planned.message);
+  out.replaced =
+      what + "; planned a path with " + std::to_string(planned.waypoints.size()) +
+      " waypoints (RRT-Connect, seed " + std::to_string(around.seed) + ")" +
+      (path.size() > 2 ? ", which replaces the " + std::to_string(path.size()) + " straight waypoints"
+                       : std::string());
+  out.record["planned"] = true;
+  out.record["replaced_straight_path"] = {
+      {"from", r.from},
+      {"to", r.to},
+      {"waypoints", path.size()},
+      {"obstacle", hit.obstacle_geom >= 0 && !hit.self ? json(hit.obstacle) : json(nullptr)},
+      {"link", hit.link_geom >= 0 ? json(hit.link) : json(nullptr)},
+      {"self", hit.self},
+      {"self_with", hit.self ? json(hit.obstacle) : json(nullptr)},
+      {"s", hit.path_fraction},
+      {"depth", hit.depth},
+      {"q", detail::to_json_array(hit.q)},
+      {"checks", checked.checks},
+      {"planner",
+       {{"name", "RRTConnect"},
+        {"seed", around.seed},
+        {"time_limit", around.time_limit},
+        {"resolution", around.resolution},
+        {"slide_resolution", around.slide_resolution},
+        {"waypoints", planned.waypoints.size()}}}};
+  out.label += hit.self
+                   ? " (planned around a self-collision of '" + hit.obstacle + "' and '" + hit.link + "')"
+                   : " (planned around '" + hit.obstacle + "')";
+  out.planned = true;
+  path = planned.waypoints;
+  return std::nullopt;
+}
+
+}  // namespace
+
+NominalPath resolve_nominal_path(const Scene& scene, const PathRequest& r) {
+  NominalPath out;
+  out.linear = r.file.empty() && !is_gripper_goal(r.from) && !is_gripper_goal(r.to);
+  std::vector<Eigen::VectorXd> path;
+  if (!r.file.empty()) {
+    path = read_path(r.file, scene);
+    out.label = r.file;
+  } else if (r.from.empty() || r.to.empty()) {
+    throw InputError(scene.source() +
+                     ": a nominal path needs a path file or two ends (keyframes, site:NAME or xyz:X,Y,Z)");
+  } else if (out.linear) {
+    path = keyframe_path(scene, r.from, r.to, r.waypoints);
+    out.label = r.from + " -> " + r.to;
+  } else {
+    out.label = r.from + " -> " + r.to;
+    EndpointOptions eo;
+    eo.ik_seed_key = r.ik_seed;
+    const auto [a, b] = resolve_endpoints(scene, r.from, r.to, eo);
+    for (const Endpoint* e : {&a, &b})
+      if (!e->reachable)
+        return refused(out, PathRefusal::kUnreachable,
+                       scene.source() + ": " + describe_unreachable(*e, e == &a));
+    const PlanResult planned =
+        plan_path(scene, a.q, b.q, r.plan, "start '" + r.from + "'", "goal '" + r.to + "'");
+    if (!planned.success) return refused(out, PathRefusal::kNoPath, scene.source() + ": " + planned.message);
+    path = planned.waypoints;
+    out.planned = true;
+  }
+  // Checked densely whatever its source: the thesis's method (chapter 3) assumes the nominal path
+  // collision-free (our reading).
+  out.record = {{"checked", true},
+                {"resolution", r.check.resolution},
+                {"slide_resolution", r.check.slide_resolution},
+                {"planned", out.planned}};
+  PathCheckResult checked = check_path(scene, path, r.check);
+  if (out.linear && !checked.free()) {
+    if (auto refusal = plan_around(scene, r, checked, path, out)) return *refusal;
+    checked = check_path(scene, path, r.check);
+  }
+  if (!checked.free()) {
+    // A path file, or a planned path that passed the planner's coarser edge check.
+    return refused(
+        out, PathRefusal::kCollision,
+        (r.file.empty() ? scene.source() : r.file) + ": " +
+            (r.file.empty() ? "the path planned from " + r.from + " to " + r.to : std::string("the path")) +
+            " " + describe_collision(scene, *checked.collision) +
+            (out.planned ? " when checked at " + format_number(r.check.resolution) +
+                               " rad (the planner checks at " + format_number(r.plan.resolution) + " rad)"
+                         : std::string()));
+  }
+  out.record["checks"] = checked.checks;
+  out.waypoints = std::move(path);
+  return out;
 }
 
 }  // namespace leeway

@@ -65,18 +65,21 @@ TuningCase::TuningCase(const CaseSpec& spec, const nlohmann::json& base_json, in
   try {
     if (!std::filesystem::is_regular_file(spec.cell)) throw InputError(spec.cell + ": no such file");
     scene_ = std::make_unique<Scene>(Scene::load(spec.cell, options));
-    path_ = keyframe_path(*scene_, spec.from, spec.to, waypoints);
-    for (const auto& q : path_) {
-      const auto outside = scene_->joints_outside_limits(q);
-      if (!outside.empty())
-        throw InputError("the path leaves the limits of joint '" +
-                         scene_->joints()[static_cast<size_t>(outside.front())].name + "'");
-    }
+    // The same nominal path as leeway bounds: checked, and planned around when it collides.
+    PathRequest request;
+    request.from = spec.from;
+    request.to = spec.to;
+    request.waypoints = waypoints;
+    const NominalPath nominal = resolve_nominal_path(*scene_, request);
+    if (!nominal.ok()) throw InputError(std::string(refusal_name(nominal.refusal)) + ": " + nominal.message);
+    path_ = nominal.waypoints;  // within the limits: check_path tests them
     // leeway-tune tunes the guide, Algorithms 2 and 3 against the volume, as published: no safety
     // stage unless the base parameters ask for one.
-    params_.safety.mode = SafetyMode::kNone;
-    apply_cell_defaults(*scene_, params_);
-    if (!base_json.is_null()) params_ = params_from_json(base_json, "the base parameters", params_);
+    ParamLayers layers;
+    layers.preset = "thesis";
+    layers.object = base_json;
+    layers.object_source = "the base parameters";
+    params_ = compose_params(*scene_, layers);
     params_.validate();
     world_ = std::make_unique<VolumeModel>(*scene_, VolumeModel::capacity_for(*scene_, pool_capacity));
   } catch (const InputError& e) {

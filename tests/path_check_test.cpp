@@ -241,6 +241,81 @@ TEST_F(PathCheckTest, BadInputThrowsWithoutNamingFlags) {
   for (const auto& m : {message({}, {}), message({q1(0)}, o)}) EXPECT_THAT(m, Not(HasSubstr("--")));
 }
 
+// ---- resolve_nominal_path: the one policy of every command ---------------------------------
+
+TEST_F(PathCheckTest, ResolveRefusesACollidingStraightPathWhenNotToPlanAround) {
+  const Scene scene = one_link();
+  PathRequest r;
+  r.from = "home";
+  r.to = "behind";
+  r.plan_around = false;
+  const NominalPath p = resolve_nominal_path(scene, r);
+  EXPECT_EQ(p.refusal, PathRefusal::kCollision);
+  EXPECT_STREQ(refusal_name(p.refusal), "collision");
+  EXPECT_TRUE(p.waypoints.empty());
+  // The touch at 1.1995 rad of 2.5: s = 0.480.
+  EXPECT_THAT(p.message,
+              HasSubstr(scene.source() + ": the straight path from home to behind hits 'wall' at s = 0.48"));
+  EXPECT_THAT(p.message, Not(HasSubstr("itself")));
+}
+
+TEST_F(PathCheckTest, ResolveNamesAKeyframeThatIsNotFreeAndThePlannersReason) {
+  const Scene scene = one_link();
+  PathRequest r;
+  r.from = "hit";
+  r.to = "home";
+  const NominalPath stuck = resolve_nominal_path(scene, r);
+  EXPECT_EQ(stuck.refusal, PathRefusal::kCollision);
+  EXPECT_THAT(stuck.message, HasSubstr("keyframe 'hit' itself is not free, so no path avoids it"));
+  // Beyond the wall: no way around it for a one-link arm within its limits.
+  r.from = "home";
+  r.to = "behind";
+  r.plan.time_limit = 0.2;
+  const NominalPath none = resolve_nominal_path(scene, r);
+  EXPECT_EQ(none.refusal, PathRefusal::kNoPath);
+  EXPECT_STREQ(refusal_name(none.refusal), "no path");
+  EXPECT_THAT(none.message, HasSubstr("the straight path from home to behind hits 'wall'"));
+  r.from.clear();
+  EXPECT_THROW(resolve_nominal_path(scene, r), InputError);
+}
+
+TEST_F(PathCheckTest, ResolveChecksAFreeStraightPathAndPlansAroundAWall) {
+  const Scene free_cell = Scene::load(workcell("dallara"));
+  PathRequest r;
+  r.from = "home";
+  r.to = "patch";
+  const NominalPath straight = resolve_nominal_path(free_cell, r);
+  ASSERT_TRUE(straight.ok()) << straight.message;
+  EXPECT_TRUE(straight.linear);
+  EXPECT_FALSE(straight.planned);
+  EXPECT_EQ(straight.label, "home -> patch");
+  EXPECT_EQ(straight.waypoints.size(), 2u);
+  EXPECT_TRUE(straight.replaced.empty());
+  // Joint 4 turns by pi: ceil(pi / 0.002) = 1571 steps plus the start.
+  EXPECT_EQ(straight.record.at("checks"), 1572);
+  EXPECT_EQ(straight.record.at("planned"), false);
+
+  const Scene walled = Scene::load(test::dallara_with_wall(dir_));
+  const NominalPath around = resolve_nominal_path(walled, r);
+  ASSERT_TRUE(around.ok()) << around.message;
+  EXPECT_TRUE(around.planned);
+  EXPECT_GT(around.waypoints.size(), 2u);
+  EXPECT_EQ(around.label, "home -> patch (planned around 'wall')");
+  EXPECT_THAT(around.replaced, HasSubstr("hits 'wall'"));
+  EXPECT_EQ(around.record.at("replaced_straight_path").at("obstacle"), "wall");
+  EXPECT_TRUE(check_path(walled, around.waypoints).free());  // what it returns is free
+}
+
+TEST_F(PathCheckTest, ResolveRefusesAnUnreachableGoal) {
+  const Scene scene = Scene::load(workcell("dallara"));
+  PathRequest r;
+  r.from = "home";
+  r.to = "xyz:5,5,5";
+  const NominalPath p = resolve_nominal_path(scene, r);
+  EXPECT_EQ(p.refusal, PathRefusal::kUnreachable);
+  EXPECT_THAT(p.message, HasSubstr(": goal 'xyz:5,5,5' at (5, 5, 5) m: no collision-free configuration"));
+}
+
 // ---- The command line ------------------------------------------------------------------------
 
 // The number after "s = " in a message (-1 when there is none).
@@ -326,11 +401,24 @@ TEST_F(CliPathCheckTest, NoPlanExitsOneAndWritesNothing) {
   EXPECT_THAT(r.out, HasSubstr("; nothing written"));
   EXPECT_THAT(r.out, Not(HasSubstr("planned a path")));
   EXPECT_FALSE(std::filesystem::exists(out));
-  // leeway sweep bounds keyframe paths too: it refuses with the same message.
-  const auto sweep = run_cli("sweep " + cell + " --from home --to patch --max-cells 100 --csv " + out);
+  // leeway sweep and render get their path the same way: with --no-plan they refuse with the same
+  // message, and without it they plan around the wall as bounds does.
+  const std::string refusal = r.out.substr(0, r.out.find(" (link"));
+  const auto sweep =
+      run_cli("sweep " + cell + " --from home --to patch --no-plan --max-cells 100 --csv " + out);
   EXPECT_EQ(sweep.exit_code, 1) << sweep.out;
-  EXPECT_THAT(sweep.out, HasSubstr(r.out.substr(0, r.out.find(" (link"))));
+  EXPECT_THAT(sweep.out, HasSubstr(refusal));
   EXPECT_FALSE(std::filesystem::exists(out));
+  const std::string png = file("r.png");
+  const auto render = run_cli("render " + cell + " --from home --to patch --no-plan --out " + png);
+  EXPECT_EQ(render.exit_code, 1) << render.out;
+  EXPECT_THAT(render.out, HasSubstr(refusal));
+  EXPECT_FALSE(std::filesystem::exists(png));
+  const auto planned = run_cli("sweep " + cell + " --from home --to patch --max-cells 100 --csv " + out);
+  EXPECT_EQ(planned.exit_code, 0) << planned.out;
+  EXPECT_THAT(planned.out, HasSubstr("the straight path from home to patch hits 'wall' at s = "));
+  EXPECT_THAT(planned.out, HasSubstr("; planned a path with "));
+  EXPECT_TRUE(std::filesystem::exists(out));
 }
 
 TEST_F(CliPathCheckTest, NoPathAroundExitsOneWithThePlannersReason) {

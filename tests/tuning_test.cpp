@@ -147,6 +147,23 @@ TEST_F(TuningTest, BadCasesFailWhenLoadedNamingTheCase) {
   }
 }
 
+// The tuner gets its path as leeway bounds does (resolve_nominal_path): checked, so a keyframe inside
+// a wall is refused before anything is tuned.
+TEST_F(TuningTest, ACaseWhosePathCollidesIsRefusedNamingTheKeyframe) {
+  const std::string walled = dir_.write(
+      "walled.xml", test::one_link_cell(R"(<geom name="wall" type="box" size="1 0.05 1" pos="0 1 1"/>)",
+                                        R"(<key name="a" qpos="0"/>
+    <key name="in" qpos="1.5708"/>)"));
+  try {
+    TuningCase(CaseSpec{walled, "a", "in"}, json(), 2, 100);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("walled.xml:a:in': collision: "));
+    EXPECT_THAT(e.what(), HasSubstr("hits 'wall'"));
+    EXPECT_THAT(e.what(), HasSubstr("keyframe 'in' itself is not free"));
+  }
+}
+
 TEST(TunedVariablesTest, ThesisValuesRoundTripThroughParams) {
   const auto vars = tuned_variables();
   ASSERT_EQ(vars.size(), 11u);

@@ -47,6 +47,12 @@ struct Endpoint {
 //! True when `spec` names a gripper goal ("site:NAME" or "xyz:X,Y,Z") rather than a keyframe.
 bool is_gripper_goal(const std::string& spec);
 
+//! Why an unreachable end has no configuration, in one line: "start 'xyz:5,5,5' at (5, 5, 5) m: no
+//! collision-free configuration with the tool pointing down within the joint limits (closest:
+//! position error 4.2 m, orientation error 0)" (the orientation error is the length of the tool
+//! axis's difference from straight down, no unit). `start`: the path's first end.
+std::string describe_unreachable(const Endpoint& end, bool start);
+
 //! Options of resolve_endpoints().
 struct EndpointOptions {
   std::string ik_seed_key;  //!< keyframe seeding every IK; "" = the policy of resolve_endpoints()

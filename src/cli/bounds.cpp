@@ -188,112 +188,29 @@ int run_bounds(const BoundsArgs& args) {
                    {args.export_mjcf, "--export-mjcf", {".xml"}},
                    {args.export_mjb, "--export-mjb", {".mjb"}}},
                   inputs);
-  std::vector<Eigen::VectorXd> path;
-  std::string label = args.from + " -> " + args.to;
   const bool linear = args.path.empty() && !is_gripper_goal(args.from) && !is_gripper_goal(args.to);
   if (!linear && args.waypoints_given)
     throw InputError("--waypoints applies to the joint-linear path between two keyframes only, not to " +
                      std::string(args.path.empty() ? "a planned path" : "--path"));
-  if (!args.path.empty()) {
-    path = read_path(args.path, scene);
-    label = args.path;
-  } else if (args.from.empty() || args.to.empty()) {
+  if (args.path.empty() && (args.from.empty() || args.to.empty()))
     throw InputError(args.cell +
                      ": give the path with --from and --to (keyframes, site:NAME or xyz:X,Y,Z)"
                      " or with --path FILE");
-  } else if (linear) {
+  if (linear) {
     // The library names the data; the command line names its flag.
     if (args.waypoints < 2)
       throw InputError("--waypoints " + std::to_string(args.waypoints) + " must be >= 2");
     require_memory(args.waypoints * kBytesPerWaypoint, "--waypoints " + std::to_string(args.waypoints));
-    path = keyframe_path(scene, args.from, args.to, args.waypoints);
-  } else {
-    PlanResult planned;
-    Endpoint a, b;
-    if (!plan_between(scene, args.from, args.to, args.ik_seed, args.plan, planned, a, b))
-      return kExitFindings;
-    path = planned.waypoints;
   }
-  // The nominal path is checked first, densely, whatever its source: the thesis's
-  // method (chapter 3) assumes it collision-free (our reading).
-  const PathCheckOptions check;
-  PathCheckResult checked = check_path(scene, path, check);
-  json nominal = {{"checked", true},
-                  {"resolution", check.resolution},
-                  {"slide_resolution", check.slide_resolution},
-                  {"planned", !linear && args.path.empty()}};
-  if (linear && !checked.free()) {
-    const PathCollision hit = *checked.collision;
-    const std::string what =
-        "the straight path from " + args.from + " to " + args.to +
-        (path.size() > 2 ? " (" + std::to_string(path.size()) + " waypoints)" : std::string()) + " " +
-        describe_collision(scene, hit, true);
-    // A keyframe that is not free itself cannot be planned around.
-    std::string stuck;
-    for (const auto& [key, q] : {std::pair{args.from, path.front()}, std::pair{args.to, path.back()}})
-      if (stuck.empty() && !check_path(scene, {q}, check).free()) stuck = key;
-    if (args.no_plan || !stuck.empty()) {
-      std::cerr << "leeway: collision: " << scene.source() << ": " << what
-                << (stuck.empty() ? ""
-                                  : "; keyframe '" + stuck + "' itself is not free, so no path avoids it")
-                << "; nothing written\n";
-      return kExitFindings;
-    }
-    PlanOptions around = args.plan;
-    around.try_direct = false;  // the straight edge may pass the planner's coarser check
-    const PlanResult planned = plan_path(scene, path.front(), path.back(), around,
-                                         "start '" + args.from + "'", "goal '" + args.to + "'");
-    if (!planned.success) {
-      std::cerr << "leeway: no path: " << scene.source() << ": " << what << "; " << planned.message
-                << "; nothing written\n";
-      return kExitFindings;
-    }
-    // Standard output stays one JSON object with --json.
-    (args.json ? std::cerr : std::cout)
-        << what << "; planned a path with " << planned.waypoints.size() << " waypoints (RRT-Connect, seed "
-        << around.seed << ")"
-        << (path.size() > 2 ? ", which replaces the " + std::to_string(path.size()) + " straight waypoints"
-                            : std::string())
-        << "\n";
-    nominal["planned"] = true;
-    nominal["replaced_straight_path"] = {
-        {"from", args.from},
-        {"to", args.to},
-        {"waypoints", path.size()},
-        {"obstacle", hit.obstacle_geom >= 0 && !hit.self ? json(hit.obstacle) : json(nullptr)},
-        {"link", hit.link_geom >= 0 ? json(hit.link) : json(nullptr)},
-        {"self", hit.self},
-        {"self_with", hit.self ? json(hit.obstacle) : json(nullptr)},
-        {"s", hit.path_fraction},
-        {"depth", hit.depth},
-        {"q", to_array(hit.q)},
-        {"checks", checked.checks},
-        {"planner",
-         {{"name", "RRTConnect"},
-          {"seed", around.seed},
-          {"time_limit", around.time_limit},
-          {"resolution", around.resolution},
-          {"slide_resolution", around.slide_resolution},
-          {"waypoints", planned.waypoints.size()}}}};
-    path = planned.waypoints;
-    label += hit.self ? " (planned around a self-collision of '" + hit.obstacle + "' and '" + hit.link + "')"
-                      : " (planned around '" + hit.obstacle + "')";
-    checked = check_path(scene, path, check);
-  }
-  if (!checked.free()) {
-    // A path file, or a planned path that passed the planner's coarser edge check.
-    const bool planned = nominal["planned"].get<bool>();
-    std::cerr << "leeway: collision: " << (args.path.empty() ? scene.source() : args.path) << ": "
-              << (args.path.empty() ? "the path planned from " + args.from + " to " + args.to
-                                    : std::string("the path"))
-              << " " << describe_collision(scene, *checked.collision)
-              << (planned ? " when checked at " + format_number(check.resolution) +
-                                " rad (the planner checks at " + format_number(args.plan.resolution) + " rad)"
-                          : std::string())
-              << "; nothing written\n";
-    return kExitFindings;
-  }
-  nominal["checks"] = checked.checks;
+  const NominalPath nominal_path = resolve_nominal_path(
+      scene,
+      path_request(args.path, args.from, args.to, args.waypoints, args.ik_seed, args.plan, !args.no_plan));
+  if (!report_refusal(nominal_path)) return kExitFindings;
+  // Standard output stays one JSON object with --json.
+  if (!nominal_path.replaced.empty()) (args.json ? std::cerr : std::cout) << nominal_path.replaced << "\n";
+  const std::vector<Eigen::VectorXd>& path = nominal_path.waypoints;
+  const std::string& label = nominal_path.label;
+  json nominal = nominal_path.record;
   VolumeModel world(scene, VolumeModel::capacity_for(scene, p.height_map.max_cells));
   const auto run = compute_bounds(scene, world, path, p, args.threads);
   json out = bounds_json(scene, run, p);

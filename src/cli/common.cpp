@@ -158,11 +158,31 @@ Eigen::VectorXd configuration(const Scene& scene, const std::string& q, const st
 
 Params load_params(const Scene& scene, const std::string& preset, const std::string& file,
                    const std::string& safety) {
-  Params p = preset_params(preset);
-  apply_cell_defaults(scene, p);
-  if (!file.empty()) p = read_params(file, p);
-  if (!safety.empty()) p.safety.mode = parse_safety_mode(safety, "--safety");
-  return p;
+  ParamLayers layers;
+  layers.preset = preset;
+  layers.file = file;
+  if (!safety.empty()) layers.safety = parse_safety_mode(safety, "--safety");
+  return compose_params(scene, layers);
+}
+
+PathRequest path_request(const std::string& file, const std::string& from, const std::string& to,
+                         int waypoints, const std::string& ik_seed, const PlanOptions& plan,
+                         bool plan_around) {
+  PathRequest r;
+  r.file = file;
+  r.from = from;
+  r.to = to;
+  r.waypoints = waypoints;
+  r.ik_seed = ik_seed;
+  r.plan = plan;
+  r.plan_around = plan_around;
+  return r;
+}
+
+bool report_refusal(const NominalPath& path) {
+  if (path.ok()) return true;
+  std::cerr << "leeway: " << refusal_name(path.refusal) << ": " << path.message << "; nothing written\n";
+  return false;
 }
 
 bool plan_between(const Scene& scene, const std::string& from, const std::string& to,
@@ -173,12 +193,8 @@ bool plan_between(const Scene& scene, const std::string& from, const std::string
   std::tie(a, b) = resolve_endpoints(scene, from, to, eo);
   for (const Endpoint* e : {&a, &b}) {
     if (e->reachable) continue;
-    std::cerr << "leeway: unreachable: " << scene.source() << ": " << (e == &a ? "start" : "goal") << " '"
-              << e->spec << "' at (" << format_number(e->position.x()) << ", "
-              << format_number(e->position.y()) << ", " << format_number(e->position.z())
-              << ") m: no collision-free configuration with the tool pointing down within the joint limits"
-              << " (closest: position error " << format_number(e->ik.position_error)
-              << " m, orientation error " << format_number(e->ik.orientation_error) << "); nothing written\n";
+    std::cerr << "leeway: unreachable: " << scene.source() << ": " << describe_unreachable(*e, e == &a)
+              << "; nothing written\n";
     return false;
   }
   result = plan_path(scene, a.q, b.q, options, "start '" + from + "'", "goal '" + to + "'");

@@ -23,6 +23,7 @@
 
 #include "leeway/endpoints.hpp"
 #include "leeway/error.hpp"
+#include "leeway/nominal_path.hpp"
 #include "leeway/params.hpp"
 #include "leeway/planner.hpp"
 #include "leeway/scene.hpp"
@@ -254,6 +255,16 @@ Eigen::VectorXd configuration(const Scene& scene, const std::string& q, const st
 //! @throws InputError on an unknown preset or safety mode or a bad parameter file.
 Params load_params(const Scene& scene, const std::string& preset, const std::string& file,
                    const std::string& safety);
+
+//! The nominal path a command's flags name (resolve_nominal_path()): --path FILE, or --from/--to with
+//! --waypoints, --ik-seed and the planner's options; `plan_around` false for --no-plan.
+PathRequest path_request(const std::string& file, const std::string& from, const std::string& to,
+                         int waypoints, const std::string& ik_seed, const PlanOptions& plan,
+                         bool plan_around);
+
+//! True for a path; on a refusal prints "leeway: <kind>: <why>; nothing written" and returns false:
+//! the caller exits with kExitFindings and writes nothing.
+bool report_refusal(const NominalPath& path);
 
 //! Plans between two path ends (docs/planning.md). On an unreachable goal or no path, prints the
 //! one-line reason and returns false: the caller exits with kExitFindings and writes nothing.

@@ -33,14 +33,16 @@ CLI::App* add_render(CLI::App& app, RenderArgs& args) {
       "render",
       "An offscreen picture (PNG, no display needed) of the cell with the robot at a waypoint and, with\n"
       "bounds (--bounds, or --from/--to computed as leeway bounds does), the volume's boxes coloured by\n"
-      "height and ghosts of the robot at the extremes of its intervals. Exit 0 on success, 1 when the\n"
-      "straight path between the keyframes collides, 2 bad input (nothing written).");
+      "height and ghosts of the robot at the extremes of its intervals. Exit 0 on success, 1 a colliding\n"
+      "path that cannot be planned around, an unreachable goal or no path, 2 bad input (nothing written).");
   sub->add_option("cell", args.cell, "MJCF file of the workcell")->required();
   auto* bounds = sub->add_option("--bounds", args.bounds, "Bounds file written by leeway bounds --out")
                      ->check(file_name_check());
-  sub->add_option("--from", args.from, "Keyframe the path starts at (bounds computed here)")
+  sub->add_option(
+         "--from", args.from,
+         "Start: a keyframe, site:NAME or xyz:X,Y,Z (bounds computed here, planned as leeway bounds plans)")
       ->excludes(bounds);
-  sub->add_option("--to", args.to, "Keyframe the path ends at")->excludes(bounds);
+  sub->add_option("--to", args.to, "Goal: a keyframe, site:NAME or xyz:X,Y,Z")->excludes(bounds);
   sub->add_option("--key", args.key, "Keyframe to show without bounds (default: the cell's first)")
       ->excludes(bounds);
   sub->add_option("--out", args.out, "PNG file to write")->check(file_name_check())->required();
@@ -64,6 +66,9 @@ CLI::App* add_render(CLI::App& app, RenderArgs& args) {
                   "Ghosts of the robot: corners (all joints at their lower, all at their upper bound),\n"
                   "joints (each joint at each bound) or none")
       ->capture_default_str();
+  sub->add_flag("--no-plan", args.no_plan,
+                "Exit 1 when the straight path between two keyframes collides instead of planning around it")
+      ->excludes(bounds);
   sub->add_option("--waypoints", args.waypoints, "Waypoints along the joint-linear path (with --from/--to)")
       ->capture_default_str();
   sub->add_option("--max-cells", args.max_cells, "MAX_cells of the height-map (with --from/--to)");
@@ -142,23 +147,20 @@ int run_render(const RenderArgs& args) {
     if (args.waypoints < 2)
       throw InputError("--waypoints " + std::to_string(args.waypoints) + " must be >= 2");
     require_memory(args.waypoints * kBytesPerWaypoint, "--waypoints " + std::to_string(args.waypoints));
-    if (args.waypoint >= args.waypoints)
-      throw InputError("--waypoint " + std::to_string(args.waypoint) + ": the path has " +
-                       std::to_string(args.waypoints) + " waypoints (0 .. " +
-                       std::to_string(args.waypoints - 1) + ")");
-    const auto path = keyframe_path(scene, args.from, args.to, args.waypoints);
-    if (const auto checked = check_path(scene, path); !checked.free()) {
-      std::cerr
-          << "leeway: collision: " << scene.source() << ": the straight path from " << args.from << " to "
-          << args.to << " " << describe_collision(scene, *checked.collision, true)
-          << "; bound a planned path with leeway bounds --out and render it with --bounds; nothing written\n";
-      return kExitFindings;
-    }
+    // As leeway bounds: a colliding straight path is planned around (default planner options).
+    const NominalPath path = resolve_nominal_path(
+        scene, path_request("", args.from, args.to, args.waypoints, "", PlanOptions{}, !args.no_plan));
+    if (!report_refusal(path)) return kExitFindings;
+    if (!path.replaced.empty()) std::cout << path.replaced << "\n";
+    const int n = static_cast<int>(path.waypoints.size());
+    if (args.waypoint >= n)
+      throw InputError("--waypoint " + std::to_string(args.waypoint) + ": the path has " + std::to_string(n) +
+                       " waypoints (0 .. " + std::to_string(n - 1) + ")");
     VolumeModel world(scene, VolumeModel::capacity_for(scene, p.height_map.max_cells));
-    BoundsRun run = compute_bounds(scene, world, path, p, args.threads);
+    BoundsRun run = compute_bounds(scene, world, path.waypoints, p, args.threads);
     bounds = std::move(run.bounds);
     volume = std::move(run.volume);
-    what = args.from + " -> " + args.to;
+    what = path.label;
   }
   const int n = static_cast<int>(bounds.size());
   if (!bounds.empty() && (args.waypoint < -1 || args.waypoint >= n))

@@ -28,6 +28,7 @@ struct RenderArgs {
   int max_cells = 0;                //!< MAX_cells, used when max_cells_given
   bool max_cells_given = false;     //!< --max-cells was on the command line (set by the parser)
   int waypoints = 2;                //!< waypoints of the joint-linear path (with --from/--to)
+  bool no_plan = false;             //!< refuse a colliding straight path instead of planning around it
   int threads = default_threads();  //!< worker threads
 };
 

@@ -57,10 +57,14 @@ CLI::App* add_sweep(CLI::App& app, SweepArgs& args) {
       "sweep", "The thesis's table: for each MAX_cells, boxes, time [ms] and CF [%], as Markdown (and CSV)");
   sub->add_option("cell", args.cell, "MJCF file of the workcell")->required();
   add_checker_option(sub, args.checker);
-  sub->add_option("--from", args.from, "Keyframe the path starts at")->required();
-  sub->add_option("--to", args.to, "Keyframe the path ends at")->required();
+  sub->add_option("--from", args.from,
+                  "Start: a keyframe, site:NAME or xyz:X,Y,Z (planned as leeway bounds plans)")
+      ->required();
+  sub->add_option("--to", args.to, "Goal: a keyframe, site:NAME or xyz:X,Y,Z")->required();
   sub->add_option("--waypoints", args.waypoints, "Waypoints along the joint-linear path")
       ->capture_default_str();
+  sub->add_flag("--no-plan", args.no_plan,
+                "Exit 1 when the straight path between two keyframes collides instead of planning around it");
   sub->add_option("--max-cells", args.max_cells,
                   "Comma-separated MAX_cells values (default: the thesis's 20)");
   sub->add_option("--params", args.params, "Parameter file (JSON)")->check(file_name_check());
@@ -107,15 +111,13 @@ int run_sweep(const SweepArgs& args) {
   StreamingOutput csv_file;
   if (!args.csv.empty()) csv_file = StreamingOutput(args.csv, "--csv");
   require_threads(args.threads);
-  const auto path = keyframe_path(scene, args.from, args.to, args.waypoints);
-  // The nominal path is checked first; a sweep bounds the straight path only.
-  if (const auto checked = check_path(scene, path); !checked.free()) {
-    std::cerr << "leeway: collision: " << scene.source() << ": the straight path from " << args.from << " to "
-              << args.to
-              << (path.size() > 2 ? " (" + std::to_string(path.size()) + " waypoints)" : std::string()) << " "
-              << describe_collision(scene, *checked.collision, true) << "; nothing written\n";
-    return kExitFindings;
-  }
+  // As leeway bounds: the nominal path is checked first, and a colliding straight path is planned
+  // around (default planner options).
+  const NominalPath nominal = resolve_nominal_path(
+      scene, path_request("", args.from, args.to, args.waypoints, "", PlanOptions{}, !args.no_plan));
+  if (!report_refusal(nominal)) return kExitFindings;
+  if (!nominal.replaced.empty()) std::cerr << nominal.replaced << "\n";
+  const std::vector<Eigen::VectorXd>& path = nominal.waypoints;
   for (int c : cells) {
     Params p = base;
     p.height_map.max_cells = c;

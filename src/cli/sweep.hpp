@@ -19,6 +19,7 @@ struct SweepArgs {
   std::string checker = "midphase";      //!< --checker
   std::string from, to;                  //!< keyframes the path starts and ends at
   int waypoints = 2;                     //!< waypoints of the joint-linear path
+  bool no_plan = false;                  //!< refuse a colliding straight path instead of planning around it
   std::string max_cells = kThesisCells;  //!< comma-separated MAX_cells values
   std::string params;                    //!< parameter file (JSON)
   std::string preset = "leeway";         //!< parameter set

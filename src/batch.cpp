@@ -231,6 +231,24 @@ std::string label_of(const json& given) {
   return cell + " " + given["from"].get<std::string>() + " -> " + given["to"].get<std::string>();
 }
 
+// A scenario's expectations (its `expect` object, checked by check_fields before).
+Expectations expectations_of(const Fields& f, const json& s) {
+  Expectations e;
+  e.check = f.flag("expect.check");
+  e.cf_min = f.number("expect.cf_min", 0, 1, "");
+  e.certified = f.flag("expect.certified");
+  e.mean_width_min = f.number("expect.mean_width_min", 0, 1e3, "");
+  if (s.contains("expect") && s["expect"].contains("self_collisions_max"))
+    e.self_collisions_max = s["expect"]["self_collisions_max"].get<long>();
+  e.time_max = f.number("expect.time_max", 0, 1e6, "");
+  if (const auto c = f.whole("expect.simulate.contacts", 0, std::numeric_limits<long long>::max()))
+    e.simulate_contacts_max = static_cast<long>(*c);
+  e.simulate_min_distance = f.number("expect.simulate.min_distance", 0, 100, "");
+  e.room_mean_share_min = f.number("expect.room.mean_share_min", 0, 1, "");
+  e.room_tool_translation_min = f.number("expect.room.tool_translation_min", 0, 100, "");
+  return e;
+}
+
 }  // namespace
 
 std::string xml_escape(const std::string& text) { return detail::xml_escape(text); }
@@ -342,22 +360,64 @@ Suite read_suite(const std::string& file) {
     sc.name = *name;
     sc.label = label_of(s);
     sc.resolved = {{"name", *name}, {"given", s}, {"run", run}};
-    sc.expect.check = f.flag("expect.check");
-    sc.expect.cf_min = f.number("expect.cf_min", 0, 1, "");
-    sc.expect.certified = f.flag("expect.certified");
-    sc.expect.mean_width_min = f.number("expect.mean_width_min", 0, 1e3, "");
-    if (s.contains("expect") && s["expect"].contains("self_collisions_max"))
-      sc.expect.self_collisions_max = s["expect"]["self_collisions_max"].get<long>();
-    sc.expect.time_max = f.number("expect.time_max", 0, 1e6, "");
-    if (const auto c = f.whole("expect.simulate.contacts", 0, std::numeric_limits<long long>::max()))
-      sc.expect.simulate_contacts_max = static_cast<long>(*c);
-    sc.expect.simulate_min_distance = f.number("expect.simulate.min_distance", 0, 100, "");
-    sc.expect.room_mean_share_min = f.number("expect.room.mean_share_min", 0, 1, "");
-    sc.expect.room_tool_translation_min = f.number("expect.room.tool_translation_min", 0, 100, "");
+    sc.expect = expectations_of(f, s);
     suite.scenarios.push_back(std::move(sc));
   }
   return suite;
 }
+
+namespace {
+
+// The nominal path a scenario names (as `leeway bounds`: a file, gripper goals, or keyframes planned
+// around when the straight path collides), with its planner settings.
+PathRequest path_request_of(const json& s) {
+  PathRequest request;
+  request.file = s.value("path", std::string());
+  request.from = s.value("from", std::string());
+  request.to = s.value("to", std::string());
+  request.waypoints = s.value("waypoints", 2);
+  request.ik_seed = s.value("ik_seed", std::string());
+  if (s.contains("plan")) {
+    request.plan.seed = s["plan"].value("seed", request.plan.seed);
+    request.plan.time_limit = s["plan"].value("time_limit", request.plan.time_limit);
+  }
+  return request;
+}
+
+// The scenario's closed loop (docs/simulate.md): its `simulate` object's settings, the outcome into
+// `measured` and its time into `timing`.
+void simulate_scenario(const Scene& scene, const std::vector<WaypointBounds>& bounds, const json& sim,
+                       json& measured, json& timing) {
+  SimulateOptions so;
+  const std::string human = sim.value("human", std::string("random"));
+  so.human.kind = human == "none"          ? HumanKind::kNone
+                  : human == "push-toward" ? HumanKind::kPushToward
+                                           : HumanKind::kRandom;
+  so.human.target = sim.value("target", std::string());
+  so.human.amplitude = sim.value("amplitude", so.human.amplitude);
+  so.human.bandwidth = sim.value("bandwidth", so.human.bandwidth);
+  so.seed = sim.value("seed", so.seed);
+  so.speed = sim.value("speed", so.speed);
+  so.controller = sim.value("controller", std::string("mpc")) == "projection" ? ControllerKind::kProjection
+                                                                              : ControllerKind::kMpc;
+  const auto s0 = Clock::now();
+  const SimulationReport sr = simulate(scene, BoundsTrajectory(scene, bounds), so);
+  timing["simulate_s"] = seconds_since(s0);
+  measured["simulate_contacts"] = sr.contact_steps;
+  measured["simulate_min_distance"] = sr.min_distance;
+  measured["simulate_left_bounds"] = sr.left_bounds;
+  measured["simulate_reached_end"] = sr.reached_end;
+  json freedom = json::array();
+  for (Eigen::Index j = 0; j < sr.freedom_used.size(); ++j) freedom.push_back(sr.freedom_used[j]);
+  measured["simulate_freedom_used"] = freedom;
+  if (sr.first_contact)
+    measured["simulate_first_contact"] = {{"t", sr.first_contact->t},
+                                          {"geom1", sr.first_contact->geom1},
+                                          {"geom2", sr.first_contact->geom2},
+                                          {"depth", sr.first_contact->depth}};
+}
+
+}  // namespace
 
 json run_scenario(const json& resolved, int threads) {
   const auto t0 = Clock::now();
@@ -382,21 +442,7 @@ json run_scenario(const json& resolved, int threads) {
       measured["check_problems"] = report.problems;
       timing["check_s"] = seconds_since(c0);
     }
-    // The nominal path: from a file, planned between gripper goals, or joint-linear between two
-    // keyframes and planned around when it collides (as `leeway bounds`).
-    PlanOptions plan;
-    if (s.contains("plan")) {
-      plan.seed = s["plan"].value("seed", plan.seed);
-      plan.time_limit = s["plan"].value("time_limit", plan.time_limit);
-    }
-    PathRequest request;
-    request.file = s.value("path", std::string());
-    request.from = s.value("from", std::string());
-    request.to = s.value("to", std::string());
-    request.waypoints = s.value("waypoints", 2);
-    request.ik_seed = s.value("ik_seed", std::string());
-    request.plan = plan;
-    const NominalPath nominal = resolve_nominal_path(scene, request);
+    const NominalPath nominal = resolve_nominal_path(scene, path_request_of(s));
     if (!nominal.ok()) throw InputError(std::string(refusal_name(nominal.refusal)) + ": " + nominal.message);
     const std::vector<Eigen::VectorXd>& path = nominal.waypoints;
     const bool planned = nominal.planned;
@@ -435,37 +481,8 @@ json run_scenario(const json& resolved, int threads) {
     measured["room_goal_tool_translation"] = room.waypoints.back().tool_translation;
     measured["room_goal_tool_rotation"] = room.waypoints.back().tool_rotation;
     // The closed loop (docs/simulate.md), when the scenario asks for it or expects its outcome.
-    if (s.contains("simulate") || (s.contains("expect") && s["expect"].contains("simulate"))) {
-      const json sim = s.value("simulate", json::object());
-      SimulateOptions so;
-      const std::string human = sim.value("human", std::string("random"));
-      so.human.kind = human == "none"          ? HumanKind::kNone
-                      : human == "push-toward" ? HumanKind::kPushToward
-                                               : HumanKind::kRandom;
-      so.human.target = sim.value("target", std::string());
-      so.human.amplitude = sim.value("amplitude", so.human.amplitude);
-      so.human.bandwidth = sim.value("bandwidth", so.human.bandwidth);
-      so.seed = sim.value("seed", so.seed);
-      so.speed = sim.value("speed", so.speed);
-      so.controller = sim.value("controller", std::string("mpc")) == "projection"
-                          ? ControllerKind::kProjection
-                          : ControllerKind::kMpc;
-      const auto s0 = Clock::now();
-      const SimulationReport sr = simulate(scene, BoundsTrajectory(scene, run.bounds), so);
-      timing["simulate_s"] = seconds_since(s0);
-      measured["simulate_contacts"] = sr.contact_steps;
-      measured["simulate_min_distance"] = sr.min_distance;
-      measured["simulate_left_bounds"] = sr.left_bounds;
-      measured["simulate_reached_end"] = sr.reached_end;
-      json freedom = json::array();
-      for (Eigen::Index j = 0; j < sr.freedom_used.size(); ++j) freedom.push_back(sr.freedom_used[j]);
-      measured["simulate_freedom_used"] = freedom;
-      if (sr.first_contact)
-        measured["simulate_first_contact"] = {{"t", sr.first_contact->t},
-                                              {"geom1", sr.first_contact->geom1},
-                                              {"geom2", sr.first_contact->geom2},
-                                              {"depth", sr.first_contact->depth}};
-    }
+    if (s.contains("simulate") || (s.contains("expect") && s["expect"].contains("simulate")))
+      simulate_scenario(scene, run.bounds, s.value("simulate", json::object()), measured, timing);
     r["status"] = "ok";
     r["measured"] = measured;
     timing["method_s"] = run.ms_total() / 1000;

@@ -81,6 +81,34 @@ CLI::App* add_render(CLI::App& app, RenderArgs& args) {
   return sub;
 }
 
+namespace {
+
+// --ghosts: corners, joints or none.
+GhostMode parse_ghosts(const std::string& text) {
+  if (text == "corners") return GhostMode::kCorners;
+  if (text == "joints") return GhostMode::kJoints;
+  if (text != "none") throw InputError("--ghosts '" + text + "' must be corners, joints or none");
+  return GhostMode::kNone;
+}
+
+// --camera AZIMUTH,ELEVATION,DISTANCE [rad, rad, m].
+RenderCamera parse_camera(const std::string& text) {
+  const Eigen::VectorXd c = parse_vector(text, "--camera");
+  if (c.size() != 3)
+    throw InputError("--camera '" + text +
+                     "' must be three numbers: azimuth [rad], elevation [rad], distance [m]");
+  if (!(c[2] > 0)) throw InputError("--camera distance " + format_number(c[2]) + " m must be > 0");
+  if (std::abs(c[1]) > 1.5707963267948966)
+    throw InputError("--camera elevation " + format_number(c[1]) + " rad must be within [-pi/2, pi/2]");
+  RenderCamera camera;
+  camera.azimuth = c[0];
+  camera.elevation = c[1];
+  camera.distance = c[2];
+  return camera;
+}
+
+}  // namespace
+
 int run_render(const RenderArgs& args) {
   // Every flag is checked before any work, so that bad input writes nothing.
   std::vector<std::string> inputs = model_input_files(args.cell);
@@ -89,28 +117,9 @@ int run_render(const RenderArgs& args) {
   const auto [width, height] = parse_size(args.size, "--size");
   if (args.volume != "on" && args.volume != "off")
     throw InputError("--volume '" + args.volume + "' must be on or off");
-  GhostMode ghosts = GhostMode::kNone;
-  if (args.ghosts == "corners")
-    ghosts = GhostMode::kCorners;
-  else if (args.ghosts == "joints")
-    ghosts = GhostMode::kJoints;
-  else if (args.ghosts != "none")
-    throw InputError("--ghosts '" + args.ghosts + "' must be corners, joints or none");
-  RenderCamera camera;
-  bool camera_given = false;
-  if (!args.camera.empty()) {
-    const Eigen::VectorXd c = parse_vector(args.camera, "--camera");
-    if (c.size() != 3)
-      throw InputError("--camera '" + args.camera +
-                       "' must be three numbers: azimuth [rad], elevation [rad], distance [m]");
-    if (!(c[2] > 0)) throw InputError("--camera distance " + format_number(c[2]) + " m must be > 0");
-    if (std::abs(c[1]) > 1.5707963267948966)
-      throw InputError("--camera elevation " + format_number(c[1]) + " rad must be within [-pi/2, pi/2]");
-    camera.azimuth = c[0];
-    camera.elevation = c[1];
-    camera.distance = c[2];
-    camera_given = true;
-  }
+  const GhostMode ghosts = parse_ghosts(args.ghosts);
+  const bool camera_given = !args.camera.empty();
+  RenderCamera camera = camera_given ? parse_camera(args.camera) : RenderCamera{};
   Eigen::Vector3d lookat;
   if (!args.lookat.empty()) {
     const Eigen::VectorXd v = parse_vector(args.lookat, "--lookat");

@@ -53,26 +53,13 @@ std::vector<Box> obstacle_boxes(const Scene& scene) {
   return boxes;
 }
 
-CheckReport check_scene(const Scene& scene, const CheckOptions& options) {
-  if (!std::isfinite(options.overlap_tolerance) || options.overlap_tolerance < 0)
-    throw InputError("overlap tolerance '" + format_number(options.overlap_tolerance) + "' must be >= 0 m");
-  if (!std::isfinite(options.reach_tolerance) || options.reach_tolerance <= 0)
-    throw InputError("reach tolerance '" + format_number(options.reach_tolerance) + "' must be > 0 m");
-  if (!(options.goal_dz >= kMinGoalDz && options.goal_dz <= 10))
-    throw InputError("goal descent step '" + format_number(options.goal_dz) + "' must be between " +
-                     format_number(kMinGoalDz) + " and 10 m");
-  // A cell `bounds` would refuse fails here too: its own parameters (custom numerics) against the
-  // default preset's, and the preset's against its joints.
-  Params cell_params = preset_params("leeway");
-  apply_cell_defaults(scene, cell_params);
-  validate_for_scene(cell_params, scene);
-  const mjModel& m = scene.model();
-  CheckReport report;
-  RobotState state(scene);
+namespace {
 
-  // Obstacles: names, types, overlaps with each other and with the robot's fixed base.
-  DataPtr rest = make_data(m);
-  mj_kinematics(&m, rest.get());
+// Obstacles: names, types, overlaps with each other and with the robot's fixed base.
+void check_obstacles(const Scene& scene, const mjData& rest_data, const CheckOptions& options,
+                     CheckReport& report) {
+  const mjModel& m = scene.model();
+  const mjData* rest = &rest_data;
   const auto& obstacles = scene.obstacle_geoms();
   if (obstacles.empty()) report.warnings.push_back("the cell has no obstacles");
   for (int g : obstacles) {
@@ -119,8 +106,10 @@ CheckReport check_scene(const Scene& scene, const CheckOptions& options) {
     report.problems.push_back("... and " + std::to_string(report.overlap_count - kMaxListedOverlaps) +
                               " more overlapping pairs (" + std::to_string(report.overlap_count) +
                               " in all; the first " + std::to_string(kMaxListedOverlaps) + " are listed)");
+}
 
-  // Keyframes: collisions and joint limits.
+// Keyframes: collisions, self-collisions and joint limits.
+void check_keyframes(const Scene& scene, RobotState& state, CheckReport& report) {
   if (scene.keyframes().empty()) report.warnings.push_back("the cell has no keyframes");
   for (const auto& k : scene.keyframes()) {
     KeyframeFindings f;
@@ -150,8 +139,14 @@ CheckReport check_scene(const Scene& scene, const CheckOptions& options) {
     }
     report.keyframes.push_back(std::move(f));
   }
+}
 
-  // Goal sites: Algorithm 1 and reach.
+// Goal sites: Algorithm 1 (a goal obstacle below each) and reach.
+void check_goals(const Scene& scene, RobotState& state, const mjData& rest_data, const CheckOptions& options,
+                 CheckReport& report) {
+  const mjModel& m = scene.model();
+  const mjData* rest = &rest_data;
+  const auto& obstacles = scene.obstacle_geoms();
   // Algorithm 1 over the obstacles with a bounding box, as categorize() searches (the plane rule,
   // box.hpp): a collidable plane is reported above, not made every goal's obstacle.
   std::vector<Box> boxes;
@@ -200,6 +195,31 @@ CheckReport check_scene(const Scene& scene, const CheckOptions& options) {
     }
     report.goals.push_back(std::move(g));
   }
+}
+
+}  // namespace
+
+CheckReport check_scene(const Scene& scene, const CheckOptions& options) {
+  if (!std::isfinite(options.overlap_tolerance) || options.overlap_tolerance < 0)
+    throw InputError("overlap tolerance '" + format_number(options.overlap_tolerance) + "' must be >= 0 m");
+  if (!std::isfinite(options.reach_tolerance) || options.reach_tolerance <= 0)
+    throw InputError("reach tolerance '" + format_number(options.reach_tolerance) + "' must be > 0 m");
+  if (!(options.goal_dz >= kMinGoalDz && options.goal_dz <= 10))
+    throw InputError("goal descent step '" + format_number(options.goal_dz) + "' must be between " +
+                     format_number(kMinGoalDz) + " and 10 m");
+  // A cell `bounds` would refuse fails here too: its own parameters (custom numerics) against the
+  // default preset's, and the preset's against its joints.
+  Params cell_params = preset_params("leeway");
+  apply_cell_defaults(scene, cell_params);
+  validate_for_scene(cell_params, scene);
+  CheckReport report;
+  RobotState state(scene);
+  const mjModel& m = scene.model();
+  DataPtr rest = make_data(m);  // the cell at rest: obstacles and sites where the model puts them
+  mj_kinematics(&m, rest.get());
+  check_obstacles(scene, *rest, options, report);
+  check_keyframes(scene, state, report);
+  check_goals(scene, state, *rest, options, report);
   return report;
 }
 

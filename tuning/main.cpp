@@ -36,18 +36,8 @@ int tune(Problem& pb, std::ostream* log) {
   return stopped_by_user ? kExitInterrupted : leeway::kExitOk;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  leeway::cli::ignore_sigpipe();  // a closed standard output is exit 2, not SIGPIPE
-  CLI::App app{
-      "leeway-tune: search the height-function parameters with NLopt to maximise CF per unit of time\n"
-      "over (cell, path) cases; writes a parameter file for `leeway bounds --params` (docs/tuning.md).\n"
-      "Exit 0 done, 2 bad input (nothing evaluated), 3 internal error, 130 interrupted (best so far "
-      "written)."};
-  Problem pb;
-  Options& o = pb.o;
-  o.cf.samples = 1000;
+// leeway-tune's options, into `o` (docs/tuning.md).
+void add_options(CLI::App& app, Options& o) {
   app.add_option("--case", o.cases, "A case CELL.xml:FROM:TO (repeat for more; required)");
   app.add_option(
       "--budget-evals", o.budget_evals,
@@ -132,6 +122,21 @@ int main(int argc, char** argv) {
   app.add_option("--noise-radius", o.noise_radius, "--noise-center's moves, as a fraction of each range")
       ->capture_default_str();
   app.add_option("--tool", o.tool, "Name of the robot's tool site")->capture_default_str();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  leeway::cli::ignore_sigpipe();  // a closed standard output is exit 2, not SIGPIPE
+  CLI::App app{
+      "leeway-tune: search the height-function parameters with NLopt to maximise CF per unit of time\n"
+      "over (cell, path) cases; writes a parameter file for `leeway bounds --params` (docs/tuning.md).\n"
+      "Exit 0 done, 2 bad input (nothing evaluated), 3 internal error, 130 interrupted (best so far "
+      "written)."};
+  Problem pb;
+  Options& o = pb.o;
+  o.cf.samples = 1000;
+  add_options(app, o);
 
   return leeway::cli::run_reporting_errors("leeway-tune", [&]() -> int {
     if (const auto code = leeway::cli::parse_cli(app, argc, argv, "leeway-tune")) return *code;

@@ -139,8 +139,10 @@ void require(bool ok, const std::string& what) {
   if (!ok) throw InputError(what);
 }
 
-void load(Problem& pb) {
-  Options& o = pb.o;
+namespace {
+
+// The options' own checks (no file read yet); sets the derived objective settings.
+void check_options(Options& o) {
   o.objective.worst_case = o.aggregate == "worst";
   o.objective.time = o.time == "wall"  ? Objective::Time::kWall
                      : o.time == "cpu" ? Objective::Time::kCpu
@@ -168,17 +170,15 @@ void load(Problem& pb) {
           "--lambda, --mu and --min-width must be >= 0");
   require(o.step > 0 && o.step <= 1, "--step must be in (0, 1]");
   leeway::tune::parse_stages(o.algorithm, o.global_share);  // throws on an unknown stage
+}
 
-  if (!o.params.empty()) {
-    pb.base_json = leeway::detail::read_json_file(o.params, "parameter file");
-    leeway::params_from_json(pb.base_json, o.params).validate();
-  }
-
-  // Variables: bounds from --range, values from --fix.
-  pb.vars = leeway::tuned_variables();
+// --range and --fix on pb.vars: bounds changed in place, pb.fixed set, the fixed values returned in
+// `fixed_value` (log10 for max_cells).
+void apply_ranges_and_fixes(Problem& pb, std::vector<double>& fixed_value) {
+  const Options& o = pb.o;
   const size_t nv = pb.vars.size();
   pb.fixed.assign(nv, false);
-  std::vector<double> fixed_value(nv, 0);
+  fixed_value.assign(nv, 0);
   for (const auto& r : o.ranges) {
     const auto [name, value] = split_assignment(r, "--range");
     bool cells = false;
@@ -209,6 +209,24 @@ void load(Problem& pb) {
     pb.fixed[i] = true;
     fixed_value[i] = v;
   }
+}
+
+}  // namespace
+
+void load(Problem& pb) {
+  Options& o = pb.o;
+  check_options(o);
+
+  if (!o.params.empty()) {
+    pb.base_json = leeway::detail::read_json_file(o.params, "parameter file");
+    leeway::params_from_json(pb.base_json, o.params).validate();
+  }
+
+  // Variables: bounds from --range, values from --fix.
+  pb.vars = leeway::tuned_variables();
+  const size_t nv = pb.vars.size();
+  std::vector<double> fixed_value;
+  apply_ranges_and_fixes(pb, fixed_value);
   const int max_cells_hi = leeway::max_cells_from_log10(pb.fixed[kCellsIndex] ? fixed_value[kCellsIndex]
                                                                               : pb.vars[kCellsIndex].upper);
 

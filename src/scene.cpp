@@ -34,6 +34,92 @@ std::string join(const std::vector<std::string>& items) {
   return out.empty() ? "(none)" : out;
 }
 
+// Robot joint j, checked: a named hinge or slide with a finite, non-empty range of workcell scale,
+// a finite axis and anchor, and a valid max speed (user[0]); all in the subtree of `robot_root`
+// (set by the first joint, -1 before it).
+RobotJoint robot_joint(const mjModel& m, int j, const std::string& file, int& robot_root) {
+  const std::string name = object_name(m, mjOBJ_JOINT, j);
+  const std::string label = name.empty() ? "#" + std::to_string(j) : "'" + name + "'";
+  if (m.jnt_type[j] != mjJNT_HINGE && m.jnt_type[j] != mjJNT_SLIDE)
+    throw InputError(file + ": joint " + label + " is a " + joint_type_name(m.jnt_type[j]) +
+                     " joint; robot joints must be hinge or slide");
+  if (name.empty())
+    throw InputError(file + ": joint #" + std::to_string(j) + " has no name; name every robot joint");
+  const int root = top_ancestor(m, m.jnt_bodyid[j]);
+  if (robot_root < 0) {
+    robot_root = root;
+  } else if (root != robot_root) {
+    throw InputError(file + ": joint " + label + " is in body '" + object_name(m, mjOBJ_BODY, root) +
+                     "', outside the robot subtree '" + object_name(m, mjOBJ_BODY, robot_root) +
+                     "'; leeway supports one robot (one top-level body with joints)");
+  }
+  if (!m.jnt_limited[j])
+    throw InputError(file + ": joint " + label + " has no range; robot joints need limits");
+  RobotJoint rj;
+  rj.name = name;
+  rj.id = j;
+  rj.prismatic = m.jnt_type[j] == mjJNT_SLIDE;
+  rj.lower = m.jnt_range[2 * j];
+  rj.upper = m.jnt_range[2 * j + 1];
+  const char* unit = rj.prismatic ? " m" : " rad";
+  if (!std::isfinite(rj.lower) || !std::isfinite(rj.upper))
+    throw InputError(file + ": joint " + label + " range '" + format_number(rj.lower) + " " +
+                     format_number(rj.upper) + "' is not finite");
+  if (rj.lower >= rj.upper)
+    throw InputError(file + ": joint " + label + " range '" + format_number(rj.lower) + " " +
+                     format_number(rj.upper) + "' is empty");
+  if (std::abs(rj.lower) > kMaxLength || std::abs(rj.upper) > kMaxLength)
+    throw InputError(file + ": joint " + label + " range '" + format_number(rj.lower) + " " +
+                     format_number(rj.upper) + "'" + unit + " goes beyond +-" + format_number(kMaxLength) +
+                     unit + " (after MuJoCo's unit conversion); no robot joint moves that far");
+  // MuJoCo compiles a NaN or inf joint axis or anchor (it normalises the axis without checking):
+  // the links' poses are then NaN at every value but the reference, and the midphase's cell
+  // index of a NaN coordinate is undefined behaviour (found by fuzzing; fuzz/regressions/cell/).
+  auto require_finite = [&](const char* what, const mjtNum* v) {
+    if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
+      throw InputError(file + ": joint " + label + " " + what + " '" + format_number(v[0]) + " " +
+                       format_number(v[1]) + " " + format_number(v[2]) + "' is not finite");
+  };
+  require_finite("axis", m.jnt_axis + 3 * j);
+  require_finite("pos", m.jnt_pos + 3 * j);
+  if (m.nuser_jnt > 0) {
+    rj.max_speed = m.jnt_user[j * m.nuser_jnt];
+    if (!std::isfinite(rj.max_speed) || rj.max_speed < 0)
+      throw InputError(file + ": joint " + label + " user[0] (max speed) '" + format_number(rj.max_speed) +
+                       "' must be a finite value >= 0");
+  }
+  return rj;
+}
+
+// Refuses values of an element that are not finite or beyond +-limit: MuJoCo compiles NaN and inf,
+// and the collision checks would then answer nonsense.
+void refuse_values(const std::string& file, const std::string& element, const char* what, const mjtNum* v,
+                   int n, double limit, const char* unit) {
+  for (int i = 0; i < n; ++i)
+    if (!std::isfinite(v[i]) || std::abs(v[i]) > limit) {
+      std::string values;
+      for (int k = 0; k < n; ++k) values += (k ? " " : "") + format_number(v[k]);
+      throw InputError(file + ": " + element + " " + what + " '" + values + "'" + unit +
+                       (std::isfinite(v[i]) ? " goes beyond +-" + format_number(limit) + unit
+                                            : std::string(" is not finite")));
+    }
+}
+
+// Keyframe k, its qpos checked finite (joint j's value is qpos entry j).
+Keyframe keyframe_of(const mjModel& m, int k, const std::string& file,
+                     const std::vector<RobotJoint>& joints) {
+  Keyframe kf;
+  kf.name = object_name(m, mjOBJ_KEY, k);
+  if (kf.name.empty()) kf.name = "#" + std::to_string(k);
+  kf.q = Eigen::Map<const Eigen::VectorXd>(m.key_qpos + k * m.nq, m.nq);
+  for (int i = 0; i < m.nq; ++i)
+    if (!std::isfinite(kf.q[i]))
+      throw InputError(file + ": keyframe '" + kf.name + "' qpos value " + std::to_string(i + 1) +
+                       " (joint '" + joints[static_cast<size_t>(i)].name + "') is '" +
+                       format_number(kf.q[i]) + "', not a finite number");
+  return kf;
+}
+
 }  // namespace
 
 std::string format_number(double v) {
@@ -108,59 +194,7 @@ void Scene::recognise(const SceneOptions& options) {
     throw InputError(file +
                      ": no robot joints: the model has no hinge or slide joint "
                      "(see docs/mjcf-conventions.md)");
-  for (int j = 0; j < m.njnt; ++j) {
-    const std::string name = object_name(m, mjOBJ_JOINT, j);
-    const std::string label = name.empty() ? "#" + std::to_string(j) : "'" + name + "'";
-    if (m.jnt_type[j] != mjJNT_HINGE && m.jnt_type[j] != mjJNT_SLIDE)
-      throw InputError(file + ": joint " + label + " is a " + joint_type_name(m.jnt_type[j]) +
-                       " joint; robot joints must be hinge or slide");
-    if (name.empty())
-      throw InputError(file + ": joint #" + std::to_string(j) + " has no name; name every robot joint");
-    const int root = top_ancestor(m, m.jnt_bodyid[j]);
-    if (robot_root_ < 0) {
-      robot_root_ = root;
-    } else if (root != robot_root_) {
-      throw InputError(file + ": joint " + label + " is in body '" + object_name(m, mjOBJ_BODY, root) +
-                       "', outside the robot subtree '" + object_name(m, mjOBJ_BODY, robot_root_) +
-                       "'; leeway supports one robot (one top-level body with joints)");
-    }
-    if (!m.jnt_limited[j])
-      throw InputError(file + ": joint " + label + " has no range; robot joints need limits");
-    RobotJoint rj;
-    rj.name = name;
-    rj.id = j;
-    rj.prismatic = m.jnt_type[j] == mjJNT_SLIDE;
-    rj.lower = m.jnt_range[2 * j];
-    rj.upper = m.jnt_range[2 * j + 1];
-    const char* unit = rj.prismatic ? " m" : " rad";
-    if (!std::isfinite(rj.lower) || !std::isfinite(rj.upper))
-      throw InputError(file + ": joint " + label + " range '" + format_number(rj.lower) + " " +
-                       format_number(rj.upper) + "' is not finite");
-    if (rj.lower >= rj.upper)
-      throw InputError(file + ": joint " + label + " range '" + format_number(rj.lower) + " " +
-                       format_number(rj.upper) + "' is empty");
-    if (std::abs(rj.lower) > kMaxLength || std::abs(rj.upper) > kMaxLength)
-      throw InputError(file + ": joint " + label + " range '" + format_number(rj.lower) + " " +
-                       format_number(rj.upper) + "'" + unit + " goes beyond +-" + format_number(kMaxLength) +
-                       unit + " (after MuJoCo's unit conversion); no robot joint moves that far");
-    // MuJoCo compiles a NaN or inf joint axis or anchor (it normalises the axis without checking):
-    // the links' poses are then NaN at every value but the reference, and the midphase's cell
-    // index of a NaN coordinate is undefined behaviour (found by fuzzing; fuzz/regressions/cell/).
-    auto require_finite = [&](const char* what, const mjtNum* v) {
-      if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
-        throw InputError(file + ": joint " + label + " " + what + " '" + format_number(v[0]) + " " +
-                         format_number(v[1]) + " " + format_number(v[2]) + "' is not finite");
-    };
-    require_finite("axis", m.jnt_axis + 3 * j);
-    require_finite("pos", m.jnt_pos + 3 * j);
-    if (m.nuser_jnt > 0) {
-      rj.max_speed = m.jnt_user[j * m.nuser_jnt];
-      if (!std::isfinite(rj.max_speed) || rj.max_speed < 0)
-        throw InputError(file + ": joint " + label + " user[0] (max speed) '" + format_number(rj.max_speed) +
-                         "' must be a finite value >= 0");
-    }
-    joints_.push_back(rj);
-  }
+  for (int j = 0; j < m.njnt; ++j) joints_.push_back(robot_joint(m, j, file, robot_root_));
   LEEWAY_DEMAND(m.nq == m.njnt);
 
   // What moves with the joints. MuJoCo numbers bodies parents first, so one pass suffices.
@@ -232,18 +266,7 @@ void Scene::recognise(const SceneOptions& options) {
   }
 
   // Keyframes.
-  for (int k = 0; k < m.nkey; ++k) {
-    Keyframe kf;
-    kf.name = object_name(m, mjOBJ_KEY, k);
-    if (kf.name.empty()) kf.name = "#" + std::to_string(k);
-    kf.q = Eigen::Map<const Eigen::VectorXd>(m.key_qpos + k * m.nq, m.nq);
-    for (int i = 0; i < m.nq; ++i)
-      if (!std::isfinite(kf.q[i]))
-        throw InputError(file + ": keyframe '" + kf.name + "' qpos value " + std::to_string(i + 1) +
-                         " (joint '" + joints_[static_cast<size_t>(i)].name + "') is '" +
-                         format_number(kf.q[i]) + "', not a finite number");
-    keyframes_.push_back(std::move(kf));
-  }
+  for (int k = 0; k < m.nkey; ++k) keyframes_.push_back(keyframe_of(m, k, file, joints_));
 
   // The static side of every robot-versus-obstacle check: every geom that is not a link, at its
   // pose at qpos0 (none of them moves with the robot's joints), indexed for the midphase.
@@ -251,21 +274,10 @@ void Scene::recognise(const SceneOptions& options) {
   mj_kinematics(&m, d.get());
   // Every collidable geom's size and pose must be finite numbers of workcell scale: MuJoCo compiles
   // NaN and inf, and the collision checks would then answer nonsense.
-  auto refuse_values = [&](const std::string& element, const char* what, const mjtNum* v, int n, double limit,
-                           const char* unit) {
-    for (int i = 0; i < n; ++i)
-      if (!std::isfinite(v[i]) || std::abs(v[i]) > limit) {
-        std::string values;
-        for (int k = 0; k < n; ++k) values += (k ? " " : "") + format_number(v[k]);
-        throw InputError(file + ": " + element + " " + what + " '" + values + "'" + unit +
-                         (std::isfinite(v[i]) ? " goes beyond +-" + format_number(limit) + unit
-                                              : std::string(" is not finite")));
-      }
-  };
   for (int g = 0; g < m.ngeom; ++g) {
     if (roles_[static_cast<size_t>(g)] == GeomRole::kIgnored) continue;
     auto refuse = [&](const char* what, const mjtNum* v, int n, double limit, const char* unit) {
-      refuse_values("geom '" + geom_label(g) + "'", what, v, n, limit, unit);
+      refuse_values(file, "geom '" + geom_label(g) + "'", what, v, n, limit, unit);
     };
     refuse("size", m.geom_size + 3 * g, 3, kMaxLength, " m");
     refuse("pos", m.geom_pos + 3 * g, 3, kMaxLength, " m");
@@ -282,10 +294,10 @@ void Scene::recognise(const SceneOptions& options) {
   sites.push_back(tool_site_);
   for (int i : sites) {
     const std::string element = "site '" + object_name(m, mjOBJ_SITE, i) + "'";
-    refuse_values(element, "pos", m.site_pos + 3 * i, 3, kMaxLength, " m");
-    refuse_values(element, "quat", m.site_quat + 4 * i, 4, 2.0, "");
-    refuse_values(element, "world position", d->site_xpos + 3 * i, 3, kMaxLength, " m");
-    refuse_values(element, "world orientation", d->site_xmat + 9 * i, 9, 2.0, "");
+    refuse_values(file, element, "pos", m.site_pos + 3 * i, 3, kMaxLength, " m");
+    refuse_values(file, element, "quat", m.site_quat + 4 * i, 4, 2.0, "");
+    refuse_values(file, element, "world position", d->site_xpos + 3 * i, 3, kMaxLength, " m");
+    refuse_values(file, element, "world orientation", d->site_xmat + 9 * i, 9, 2.0, "");
   }
   std::vector<int> statics;
   for (int g = 0; g < m.ngeom; ++g)

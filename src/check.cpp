@@ -56,10 +56,9 @@ std::vector<Box> obstacle_boxes(const Scene& scene) {
 namespace {
 
 // Obstacles: names, types, overlaps with each other and with the robot's fixed base.
-void check_obstacles(const Scene& scene, const mjData& rest_data, const CheckOptions& options,
+void check_obstacles(const Scene& scene, const mjData& rest, const CheckOptions& options,
                      CheckReport& report) {
   const mjModel& m = scene.model();
-  const mjData* rest = &rest_data;
   const auto& obstacles = scene.obstacle_geoms();
   if (obstacles.empty()) report.warnings.push_back("the cell has no obstacles");
   for (int g : obstacles) {
@@ -74,7 +73,7 @@ void check_obstacles(const Scene& scene, const mjData& rest_data, const CheckOpt
                                 " is not a box: the volume uses its bounding box");
   }
   auto add_overlap = [&](int a, int b, const char* what) {
-    const double depth = penetration(m, *rest, a, b);
+    const double depth = penetration(m, rest, a, b);
     if (depth > options.overlap_tolerance) {
       // Counted all, listed up to a limit: n coincident obstacles overlap in n (n - 1) / 2 pairs.
       if (++report.overlap_count > kMaxListedOverlaps) return;
@@ -87,7 +86,7 @@ void check_obstacles(const Scene& scene, const mjData& rest_data, const CheckOpt
   // (a pair that overlaps by more than the tolerance >= 0 must): the midphase's grid keeps this
   // linear in the obstacles instead of quadratic.
   std::vector<Aabb> aabbs;
-  for (int g : obstacles) aabbs.push_back(geom_aabb(m, *rest, g));
+  for (int g : obstacles) aabbs.push_back(geom_aabb(m, rest, g));
   AabbGrid grid;
   grid.build(aabbs);
   std::vector<int> near;
@@ -142,10 +141,9 @@ void check_keyframes(const Scene& scene, RobotState& state, CheckReport& report)
 }
 
 // Goal sites: Algorithm 1 (a goal obstacle below each) and reach.
-void check_goals(const Scene& scene, RobotState& state, const mjData& rest_data, const CheckOptions& options,
+void check_goals(const Scene& scene, RobotState& state, const mjData& rest, const CheckOptions& options,
                  CheckReport& report) {
   const mjModel& m = scene.model();
-  const mjData* rest = &rest_data;
   const auto& obstacles = scene.obstacle_geoms();
   // Algorithm 1 over the obstacles with a bounding box, as categorize() searches (the plane rule,
   // box.hpp): a collidable plane is reported above, not made every goal's obstacle.
@@ -153,7 +151,7 @@ void check_goals(const Scene& scene, RobotState& state, const mjData& rest_data,
   std::vector<int> box_geoms;
   for (int g : obstacles)
     if (has_bounding_box(m, g)) {
-      boxes.push_back(geom_box(m, *rest, g));
+      boxes.push_back(geom_box(m, rest, g));
       box_geoms.push_back(g);
     }
   if (scene.goal_sites().empty()) report.warnings.push_back("the cell has no goal sites");
@@ -162,7 +160,7 @@ void check_goals(const Scene& scene, RobotState& state, const mjData& rest_data,
     GoalFindings g;
     g.site = object_name(m, mjOBJ_SITE, s);
     if (g.site.empty()) g.site = "#" + std::to_string(s);
-    g.position = Eigen::Map<const Eigen::Vector3d>(rest->site_xpos + 3 * s);
+    g.position = Eigen::Map<const Eigen::Vector3d>(rest.site_xpos + 3 * s);
     const auto found = find_goal_obstacle(g.position, boxes, options.goal_dz);
     if (found) {
       g.goal_obstacle = box_geoms[*found];

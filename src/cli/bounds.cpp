@@ -202,9 +202,15 @@ int run_bounds(const BoundsArgs& args) {
       throw InputError("--waypoints " + std::to_string(args.waypoints) + " must be >= 2");
     require_memory(args.waypoints * kBytesPerWaypoint, "--waypoints " + std::to_string(args.waypoints));
   }
-  const NominalPath nominal_path = resolve_nominal_path(
-      scene,
-      path_request(args.path, args.from, args.to, args.waypoints, args.ik_seed, args.plan, !args.no_plan));
+  PathRequest request;
+  request.file = args.path;
+  request.from = args.from;
+  request.to = args.to;
+  request.waypoints = args.waypoints;
+  request.ik_seed = args.ik_seed;
+  request.plan = args.plan;
+  request.plan_around = !args.no_plan;
+  const NominalPath nominal_path = resolve_nominal_path(scene, request);
   if (!report_refusal(nominal_path)) return kExitFindings;
   // Standard output stays one JSON object with --json.
   if (!nominal_path.replaced.empty()) (args.json ? std::cerr : std::cout) << nominal_path.replaced << "\n";

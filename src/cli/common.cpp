@@ -165,20 +165,6 @@ Params load_params(const Scene& scene, const std::string& preset, const std::str
   return compose_params(scene, layers);
 }
 
-PathRequest path_request(const std::string& file, const std::string& from, const std::string& to,
-                         int waypoints, const std::string& ik_seed, const PlanOptions& plan,
-                         bool plan_around) {
-  PathRequest r;
-  r.file = file;
-  r.from = from;
-  r.to = to;
-  r.waypoints = waypoints;
-  r.ik_seed = ik_seed;
-  r.plan = plan;
-  r.plan_around = plan_around;
-  return r;
-}
-
 bool report_refusal(const NominalPath& path) {
   if (path.ok()) return true;
   std::cerr << "leeway: " << refusal_name(path.refusal) << ": " << path.message << "; nothing written\n";

@@ -256,12 +256,6 @@ Eigen::VectorXd configuration(const Scene& scene, const std::string& q, const st
 Params load_params(const Scene& scene, const std::string& preset, const std::string& file,
                    const std::string& safety);
 
-//! The nominal path a command's flags name (resolve_nominal_path()): --path FILE, or --from/--to with
-//! --waypoints, --ik-seed and the planner's options; `plan_around` false for --no-plan.
-PathRequest path_request(const std::string& file, const std::string& from, const std::string& to,
-                         int waypoints, const std::string& ik_seed, const PlanOptions& plan,
-                         bool plan_around);
-
 //! True for a path; on a refusal prints "leeway: <kind>: <why>; nothing written" and returns false:
 //! the caller exits with kExitFindings and writes nothing.
 bool report_refusal(const NominalPath& path);

@@ -157,8 +157,12 @@ int run_render(const RenderArgs& args) {
       throw InputError("--waypoints " + std::to_string(args.waypoints) + " must be >= 2");
     require_memory(args.waypoints * kBytesPerWaypoint, "--waypoints " + std::to_string(args.waypoints));
     // As leeway bounds: a colliding straight path is planned around (default planner options).
-    const NominalPath path = resolve_nominal_path(
-        scene, path_request("", args.from, args.to, args.waypoints, "", PlanOptions{}, !args.no_plan));
+    PathRequest request;
+    request.from = args.from;
+    request.to = args.to;
+    request.waypoints = args.waypoints;
+    request.plan_around = !args.no_plan;
+    const NominalPath path = resolve_nominal_path(scene, request);
     if (!report_refusal(path)) return kExitFindings;
     if (!path.replaced.empty()) std::cout << path.replaced << "\n";
     const int n = static_cast<int>(path.waypoints.size());

@@ -113,8 +113,12 @@ int run_sweep(const SweepArgs& args) {
   require_threads(args.threads);
   // As leeway bounds: the nominal path is checked first, and a colliding straight path is planned
   // around (default planner options).
-  const NominalPath nominal = resolve_nominal_path(
-      scene, path_request("", args.from, args.to, args.waypoints, "", PlanOptions{}, !args.no_plan));
+  PathRequest request;
+  request.from = args.from;
+  request.to = args.to;
+  request.waypoints = args.waypoints;
+  request.plan_around = !args.no_plan;
+  const NominalPath nominal = resolve_nominal_path(scene, request);
   if (!report_refusal(nominal)) return kExitFindings;
   if (!nominal.replaced.empty()) std::cerr << nominal.replaced << "\n";
   const std::vector<Eigen::VectorXd>& path = nominal.waypoints;

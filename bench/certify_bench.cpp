@@ -21,14 +21,14 @@
 #include <string>
 #include <vector>
 
-#include "leeway/cell_defaults.hpp"
-#include "leeway/certify.hpp"
-#include "leeway/error.hpp"
-#include "leeway/file_io.hpp"
-#include "leeway/nominal_path.hpp"
-#include "leeway/pipeline.hpp"
-#include "leeway/tuning.hpp"
-#include "statistics.hpp"
+#include "apps/statistics.hpp"
+#include "leeway/apps/tuning.hpp"
+#include "leeway/core/cell_defaults.hpp"
+#include "leeway/core/certify.hpp"
+#include "leeway/core/error.hpp"
+#include "leeway/core/file_io.hpp"
+#include "leeway/core/pipeline.hpp"
+#include "leeway/path/nominal_path.hpp"
 
 namespace {
 

@@ -13,13 +13,13 @@
 #include <random>
 #include <string>
 
-#include "leeway/categorize.hpp"
-#include "leeway/cell_defaults.hpp"
-#include "leeway/confidence.hpp"
-#include "leeway/mujoco_util.hpp"
-#include "leeway/nominal_path.hpp"
-#include "leeway/pipeline.hpp"
-#include "random.hpp"
+#include "core/random.hpp"
+#include "leeway/core/categorize.hpp"
+#include "leeway/core/cell_defaults.hpp"
+#include "leeway/core/confidence.hpp"
+#include "leeway/core/mujoco_util.hpp"
+#include "leeway/core/pipeline.hpp"
+#include "leeway/path/nominal_path.hpp"
 
 namespace {
 

@@ -13,13 +13,13 @@
 #include <string>
 #include <vector>
 
-#include "leeway/cell_defaults.hpp"
-#include "leeway/error.hpp"
-#include "leeway/nominal_path.hpp"
-#include "leeway/pipeline.hpp"
-#include "leeway/tuning.hpp"
-#include "random.hpp"
-#include "statistics.hpp"
+#include "apps/statistics.hpp"
+#include "core/random.hpp"
+#include "leeway/apps/tuning.hpp"
+#include "leeway/core/cell_defaults.hpp"
+#include "leeway/core/error.hpp"
+#include "leeway/core/pipeline.hpp"
+#include "leeway/path/nominal_path.hpp"
 
 namespace {
 

@@ -12,7 +12,7 @@
 #include <random>
 #include <vector>
 
-#include "leeway/bounds_trajectory.hpp"
+#include "leeway/core/bounds_trajectory.hpp"
 
 namespace {
 

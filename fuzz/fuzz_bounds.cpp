@@ -16,7 +16,7 @@
 #include <cstdlib>
 
 #include "fuzz_input.hpp"
-#include "leeway/bounds_file.hpp"
+#include "leeway/io/bounds_file.hpp"
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
   leeway::fuzz::dallara_scene();

@@ -33,11 +33,11 @@
 #include <vector>
 
 #include "fuzz_input.hpp"
-#include "leeway/cell_defaults.hpp"
-#include "leeway/kinematics.hpp"
-#include "leeway/mujoco_util.hpp"
-#include "leeway/params.hpp"
-#include "leeway/scene.hpp"
+#include "leeway/core/cell_defaults.hpp"
+#include "leeway/core/kinematics.hpp"
+#include "leeway/core/mujoco_util.hpp"
+#include "leeway/core/params.hpp"
+#include "leeway/core/scene.hpp"
 
 namespace {
 

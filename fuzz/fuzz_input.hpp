@@ -14,9 +14,9 @@
 #include <fstream>
 #include <string>
 
-#include "leeway/error.hpp"
-#include "leeway/mujoco_util.hpp"
-#include "leeway/scene.hpp"
+#include "leeway/core/error.hpp"
+#include "leeway/core/mujoco_util.hpp"
+#include "leeway/core/scene.hpp"
 
 namespace leeway::fuzz {
 

@@ -13,7 +13,7 @@
 #include <cstdlib>
 
 #include "fuzz_input.hpp"
-#include "leeway/params.hpp"
+#include "leeway/core/params.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const leeway::fuzz::InputFile input("params.json");

@@ -15,7 +15,7 @@
 #include <cstdlib>
 
 #include "fuzz_input.hpp"
-#include "leeway/nominal_path.hpp"
+#include "leeway/path/nominal_path.hpp"
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
   leeway::fuzz::dallara_scene();

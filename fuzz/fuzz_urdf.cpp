@@ -27,9 +27,9 @@
 #include <string>
 
 #include "fuzz_input.hpp"
-#include "leeway/mujoco_util.hpp"
-#include "leeway/scene.hpp"
-#include "leeway/urdf_import.hpp"
+#include "leeway/core/mujoco_util.hpp"
+#include "leeway/core/scene.hpp"
+#include "leeway/io/urdf_import.hpp"
 
 namespace {
 

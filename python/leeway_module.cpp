@@ -18,21 +18,21 @@
 #include <utility>
 #include <vector>
 
-#include "json_io.hpp"
-#include "leeway/bounds_file.hpp"
-#include "leeway/bounds_trajectory.hpp"
-#include "leeway/cell_defaults.hpp"
-#include "leeway/check.hpp"
-#include "leeway/confidence.hpp"
-#include "leeway/error.hpp"
-#include "leeway/file_io.hpp"
-#include "leeway/mujoco_util.hpp"
-#include "leeway/nominal_path.hpp"
-#include "leeway/params.hpp"
-#include "leeway/path_check.hpp"
-#include "leeway/pipeline.hpp"
-#include "leeway/scene.hpp"
-#include "leeway/volume_world.hpp"
+#include "core/json_io.hpp"
+#include "leeway/core/bounds_trajectory.hpp"
+#include "leeway/core/cell_defaults.hpp"
+#include "leeway/core/check.hpp"
+#include "leeway/core/confidence.hpp"
+#include "leeway/core/error.hpp"
+#include "leeway/core/file_io.hpp"
+#include "leeway/core/mujoco_util.hpp"
+#include "leeway/core/params.hpp"
+#include "leeway/core/pipeline.hpp"
+#include "leeway/core/scene.hpp"
+#include "leeway/core/volume_world.hpp"
+#include "leeway/io/bounds_file.hpp"
+#include "leeway/path/nominal_path.hpp"
+#include "leeway/path/path_check.hpp"
 
 namespace py = pybind11;
 using nlohmann::json;

@@ -14,7 +14,7 @@
 
 #include <unistd.h>
 
-#include "leeway/batch.hpp"
+#include "leeway/apps/batch.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

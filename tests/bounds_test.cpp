@@ -1,6 +1,6 @@
 // Jointspace exploration (thesis section 3.3): Algorithm 2 against hand-worked bisection sequences
 // and an analytic MuJoCo scene, Algorithm 3's properties on the Dallara cell with a real volume.
-#include "leeway/bounds.hpp"
+#include "leeway/core/bounds.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -12,12 +12,12 @@
 #include <string>
 #include <vector>
 
-#include "leeway/bounds_file.hpp"
-#include "leeway/cell_defaults.hpp"
-#include "leeway/error.hpp"
-#include "leeway/kinematics.hpp"
-#include "leeway/nominal_path.hpp"
-#include "leeway/pipeline.hpp"
+#include "leeway/core/cell_defaults.hpp"
+#include "leeway/core/error.hpp"
+#include "leeway/core/kinematics.hpp"
+#include "leeway/core/pipeline.hpp"
+#include "leeway/io/bounds_file.hpp"
+#include "leeway/path/nominal_path.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

@@ -2,7 +2,7 @@
 // worked out by hand, the bounds file's format 2 (times in the file, format 1 still read), and the
 // exports of `leeway sample` (CSV, JSON, .npz read back by an independent zip/npy reader here, Drake
 // YAML).
-#include "leeway/bounds_trajectory.hpp"
+#include "leeway/core/bounds_trajectory.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -19,14 +19,14 @@
 #include <string>
 #include <vector>
 
-#include "leeway/bounds_export.hpp"
-#include "leeway/bounds_file.hpp"
-#include "leeway/cell_defaults.hpp"
-#include "leeway/confidence.hpp"
-#include "leeway/error.hpp"
-#include "leeway/nominal_path.hpp"
-#include "leeway/pipeline.hpp"
-#include "leeway/volume_world.hpp"
+#include "leeway/core/cell_defaults.hpp"
+#include "leeway/core/confidence.hpp"
+#include "leeway/core/error.hpp"
+#include "leeway/core/pipeline.hpp"
+#include "leeway/core/volume_world.hpp"
+#include "leeway/io/bounds_export.hpp"
+#include "leeway/io/bounds_file.hpp"
+#include "leeway/path/nominal_path.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

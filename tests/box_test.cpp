@@ -1,4 +1,4 @@
-#include "leeway/box.hpp"
+#include "leeway/core/box.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,10 +1,10 @@
-#include "leeway/categorize.hpp"
+#include "leeway/core/categorize.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "leeway/error.hpp"
+#include "leeway/core/error.hpp"
 
 namespace leeway {
 namespace {

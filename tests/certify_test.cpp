@@ -1,7 +1,7 @@
 // The certificate of free joint-space regions (src/certify.cpp): random regions and segments of the
 // bundled workcells against brute-force sampling with the exact clearance, and small cells whose
 // certified extents are derived by hand.
-#include "leeway/certify.hpp"
+#include "leeway/core/certify.hpp"
 
 #include <gtest/gtest.h>
 
@@ -18,10 +18,10 @@
 #include <utility>
 #include <vector>
 
-#include "leeway/box.hpp"
-#include "leeway/error.hpp"
-#include "leeway/kinematics.hpp"
-#include "leeway/scene.hpp"
+#include "leeway/core/box.hpp"
+#include "leeway/core/error.hpp"
+#include "leeway/core/kinematics.hpp"
+#include "leeway/core/scene.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

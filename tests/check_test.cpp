@@ -1,4 +1,4 @@
-#include "leeway/check.hpp"
+#include "leeway/core/check.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "leeway/box.hpp"
-#include "leeway/kinematics.hpp"
+#include "leeway/core/box.hpp"
+#include "leeway/core/kinematics.hpp"
 
 #include "test_util.hpp"
 

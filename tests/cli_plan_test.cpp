@@ -8,9 +8,9 @@
 #include <sstream>
 #include <string>
 
-#include "leeway/endpoints.hpp"
-#include "leeway/kinematics.hpp"
-#include "leeway/nominal_path.hpp"
+#include "leeway/core/kinematics.hpp"
+#include "leeway/path/endpoints.hpp"
+#include "leeway/path/nominal_path.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

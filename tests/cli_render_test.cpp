@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "leeway/export_mjcf.hpp"
-#include "leeway/plot.hpp"
-#include "leeway/render.hpp"
-#include "leeway/scene.hpp"
+#include "leeway/core/scene.hpp"
+#include "leeway/viz/export_mjcf.hpp"
+#include "leeway/viz/plot.hpp"
+#include "leeway/viz/render.hpp"
 #include "png_util.hpp"
 #include "test_util.hpp"
 

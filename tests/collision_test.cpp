@@ -1,6 +1,6 @@
 // The fast collision core: the midphase grid against brute force, and the midphase
 // checker against MuJoCo's full mj_collision pass on the three thesis cells.
-#include "leeway/collision.hpp"
+#include "leeway/core/collision.hpp"
 
 #include <gtest/gtest.h>
 
@@ -10,18 +10,18 @@
 #include <random>
 #include <set>
 
-#include "leeway/bounds.hpp"
-#include "leeway/box.hpp"
-#include "leeway/categorize.hpp"
-#include "leeway/error.hpp"
-#include "leeway/kinematics.hpp"
-#include "leeway/midphase.hpp"
-#include "leeway/mujoco_util.hpp"
-#include "leeway/nominal_path.hpp"
-#include "leeway/params.hpp"
-#include "leeway/volume.hpp"
-#include "leeway/volume_world.hpp"
-#include "random.hpp"
+#include "core/random.hpp"
+#include "leeway/core/bounds.hpp"
+#include "leeway/core/box.hpp"
+#include "leeway/core/categorize.hpp"
+#include "leeway/core/error.hpp"
+#include "leeway/core/kinematics.hpp"
+#include "leeway/core/midphase.hpp"
+#include "leeway/core/mujoco_util.hpp"
+#include "leeway/core/params.hpp"
+#include "leeway/core/volume.hpp"
+#include "leeway/core/volume_world.hpp"
+#include "leeway/path/nominal_path.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

@@ -1,6 +1,6 @@
 // The Confidence Factor (thesis section 4.1) against hand-computed Wilson intervals and the
 // analytic collision-free share of the one-link arm next to a wall.
-#include "leeway/confidence.hpp"
+#include "leeway/core/confidence.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -8,7 +8,7 @@
 #include <cmath>
 #include <vector>
 
-#include "leeway/error.hpp"
+#include "leeway/core/error.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

@@ -1,6 +1,6 @@
 // export_mjcf.hpp: the cell with its volume as MJCF written in another folder (includes inlined,
 // asset paths rewritten) and as MJB, compiled by MuJoCo without warnings.
-#include "leeway/export_mjcf.hpp"
+#include "leeway/viz/export_mjcf.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -10,7 +10,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "leeway/error.hpp"
+#include "leeway/core/error.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

@@ -1,7 +1,7 @@
 // The output-path policy (file_io.hpp): temporary files that never follow or reuse a name someone
 // else placed, outputs refused when they are links, inputs of the run or each other, and streamed
 // outputs locked against a second writer.
-#include "leeway/file_io.hpp"
+#include "leeway/core/file_io.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "leeway/error.hpp"
+#include "leeway/core/error.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

@@ -8,8 +8,8 @@
 #include <random>
 #include <string>
 
-#include "leeway/kinematics.hpp"
-#include "leeway/safety.hpp"
+#include "leeway/core/kinematics.hpp"
+#include "leeway/core/safety.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

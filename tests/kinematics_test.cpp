@@ -1,4 +1,4 @@
-#include "leeway/kinematics.hpp"
+#include "leeway/core/kinematics.hpp"
 
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 #include <cstring>
 #include <random>
 
-#include "leeway/error.hpp"
+#include "leeway/core/error.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

@@ -1,6 +1,6 @@
 // The MJCF text before MuJoCo sees it (mjcf_source.hpp): every numeric attribute finite, in the
 // model file and the files it includes, and the list of files MuJoCo 2.2.2 reads for a model.
-#include "leeway/mjcf_source.hpp"
+#include "leeway/core/mjcf_source.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "leeway/mujoco_util.hpp"
-#include "leeway/scene.hpp"
+#include "leeway/core/mujoco_util.hpp"
+#include "leeway/core/scene.hpp"
 #include "stl_util.hpp"
 #include "test_util.hpp"
 

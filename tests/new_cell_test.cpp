@@ -1,15 +1,15 @@
 // The cell template: a minimal cell around a robot fragment passes the checker; its home keyframe
 // and reach radius by hand; bad robots leave nothing behind.
-#include "leeway/new_cell.hpp"
+#include "leeway/io/new_cell.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
 
-#include "leeway/check.hpp"
-#include "leeway/error.hpp"
-#include "leeway/scene.hpp"
+#include "leeway/core/check.hpp"
+#include "leeway/core/error.hpp"
+#include "leeway/core/scene.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

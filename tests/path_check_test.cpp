@@ -1,6 +1,6 @@
 // The dense check of the nominal path: the library against positions derived by hand
 // from the geometry, and `leeway bounds` / `leeway sweep` as a user runs them.
-#include "leeway/path_check.hpp"
+#include "leeway/path/path_check.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -14,9 +14,9 @@
 #include <sstream>
 #include <string>
 
-#include "leeway/error.hpp"
-#include "leeway/kinematics.hpp"
-#include "leeway/nominal_path.hpp"
+#include "leeway/core/error.hpp"
+#include "leeway/core/kinematics.hpp"
+#include "leeway/path/nominal_path.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

@@ -1,9 +1,9 @@
 // The whole method on one path: keyframe paths, cell defaults, the bounds file and atomic writes.
-#include "leeway/pipeline.hpp"
-#include "leeway/bounds_file.hpp"
-#include "leeway/cell_defaults.hpp"
-#include "leeway/file_io.hpp"
-#include "leeway/nominal_path.hpp"
+#include "leeway/core/pipeline.hpp"
+#include "leeway/core/cell_defaults.hpp"
+#include "leeway/core/file_io.hpp"
+#include "leeway/io/bounds_file.hpp"
+#include "leeway/path/nominal_path.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -16,7 +16,7 @@
 #include <memory>
 #include <string>
 
-#include "leeway/error.hpp"
+#include "leeway/core/error.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

@@ -1,6 +1,6 @@
-#include "leeway/planner.hpp"
-#include "leeway/endpoints.hpp"
-#include "leeway/nominal_path.hpp"
+#include "leeway/path/planner.hpp"
+#include "leeway/path/endpoints.hpp"
+#include "leeway/path/nominal_path.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include <fstream>
 #include <thread>
 
-#include "leeway/error.hpp"
+#include "leeway/core/error.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

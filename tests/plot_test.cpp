@@ -1,10 +1,10 @@
 // plot.hpp: the thesis's tables as embedded, bounds files read for plotting, and bad plot input.
-#include "leeway/plot.hpp"
+#include "leeway/viz/plot.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "leeway/error.hpp"
+#include "leeway/core/error.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "leeway/render.hpp"
+#include "leeway/viz/render.hpp"
 
 namespace leeway::test {
 

@@ -22,12 +22,12 @@
 #include <vector>
 
 #include "cli/common.hpp"
-#include "json_io.hpp"
-#include "leeway/file_io.hpp"
-#include "leeway/kinematics.hpp"
-#include "leeway/mujoco_util.hpp"
-#include "leeway/scene.hpp"
-#include "parallel.hpp"
+#include "core/json_io.hpp"
+#include "core/parallel.hpp"
+#include "leeway/core/file_io.hpp"
+#include "leeway/core/kinematics.hpp"
+#include "leeway/core/mujoco_util.hpp"
+#include "leeway/core/scene.hpp"
 #include "stl_util.hpp"
 #include "test_util.hpp"
 

@@ -1,13 +1,13 @@
 // render.hpp: PNG encoding, the camera model, height colours, ghosts and an offscreen render of a
 // one-link cell with one volume box, checked against hand-worked values.
-#include "leeway/render.hpp"
+#include "leeway/viz/render.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
 
-#include "leeway/error.hpp"
+#include "leeway/core/error.hpp"
 #include "png_util.hpp"
 #include "test_util.hpp"
 

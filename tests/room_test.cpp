@@ -5,8 +5,8 @@
 #include <cmath>
 #include <string>
 
-#include "leeway/kinematics.hpp"
-#include "leeway/room.hpp"
+#include "leeway/core/kinematics.hpp"
+#include "leeway/core/room.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

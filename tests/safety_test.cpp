@@ -9,8 +9,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "leeway/confidence.hpp"
-#include "leeway/safety.hpp"
+#include "leeway/core/confidence.hpp"
+#include "leeway/core/safety.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

@@ -1,11 +1,11 @@
-#include "leeway/scene.hpp"
+#include "leeway/core/scene.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <set>
 
-#include "leeway/error.hpp"
+#include "leeway/core/error.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

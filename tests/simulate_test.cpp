@@ -2,7 +2,7 @@
 // arm beside a wall whose bounds are known, on the Dallara cell with the default bounds (no contact,
 // never outside the bounds, checked at every control period from outside the simulation) and with
 // the thesis preset's bounds where its CF is below 100 % (the adversarial push finds a contact).
-#include "leeway/simulate.hpp"
+#include "leeway/core/simulate.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "leeway/bounds_file.hpp"
-#include "leeway/error.hpp"
-#include "leeway/joint_mpc.hpp"
+#include "leeway/core/error.hpp"
+#include "leeway/core/joint_mpc.hpp"
+#include "leeway/io/bounds_file.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

@@ -1,10 +1,10 @@
 // STL reading: binary and ASCII files written here, their vertices and bounding boxes by hand.
-#include "leeway/stl.hpp"
+#include "leeway/io/stl.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "leeway/error.hpp"
+#include "leeway/core/error.hpp"
 #include "stl_util.hpp"
 #include "test_util.hpp"
 

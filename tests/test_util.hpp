@@ -18,8 +18,8 @@
 
 #include <sys/wait.h>
 
-#include "leeway/error.hpp"
-#include "leeway/mujoco_util.hpp"
+#include "leeway/core/error.hpp"
+#include "leeway/core/mujoco_util.hpp"
 
 // LEEWAY_TEST_ASAN: this build runs under AddressSanitizer (LEEWAY_SANITIZE=address, gcc or clang).
 #if defined(__SANITIZE_ADDRESS__)

@@ -14,10 +14,10 @@
 #include <sstream>
 #include <thread>
 
-#include "leeway/error.hpp"
-#include "leeway/nominal_path.hpp"
-#include "leeway/tuning.hpp"
-#include "statistics.hpp"
+#include "apps/statistics.hpp"
+#include "leeway/apps/tuning.hpp"
+#include "leeway/core/error.hpp"
+#include "leeway/path/nominal_path.hpp"
 #include "test_util.hpp"
 #include "tuner.hpp"
 

@@ -1,7 +1,7 @@
 // The URDF importer: the IRB 6700 written as URDF against leeway's hand-written MJCF of it, the
 // boxes of each collision shape, package:// resolution, a 7-joint arm end to end, and bad URDFs
 // (exit 2, one message naming file, element and value, no file written).
-#include "leeway/urdf_import.hpp"
+#include "leeway/io/urdf_import.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -11,10 +11,10 @@
 #include <fstream>
 #include <random>
 
-#include "leeway/box.hpp"
-#include "leeway/check.hpp"
-#include "leeway/kinematics.hpp"
-#include "leeway/scene.hpp"
+#include "leeway/core/box.hpp"
+#include "leeway/core/check.hpp"
+#include "leeway/core/kinematics.hpp"
+#include "leeway/core/scene.hpp"
 #include "stl_util.hpp"
 #include "test_util.hpp"
 

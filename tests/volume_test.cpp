@@ -1,4 +1,4 @@
-#include "leeway/volume.hpp"
+#include "leeway/core/volume.hpp"
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 #include <random>
 #include <string>
 
-#include "leeway/error.hpp"
+#include "leeway/core/error.hpp"
 
 namespace leeway {
 namespace {

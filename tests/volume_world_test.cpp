@@ -1,4 +1,4 @@
-#include "leeway/volume_world.hpp"
+#include "leeway/core/volume_world.hpp"
 
 #include <gtest/gtest.h>
 #include <mujoco/mjxmacro.h>
@@ -8,7 +8,7 @@
 #include <random>
 #include <sstream>
 
-#include "random.hpp"
+#include "core/random.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

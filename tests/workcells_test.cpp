@@ -7,7 +7,7 @@
 #include <cmath>
 #include <vector>
 
-#include "leeway/check.hpp"
+#include "leeway/core/check.hpp"
 #include "test_util.hpp"
 
 namespace leeway {

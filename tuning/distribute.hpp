@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "dist.hpp"
+#include "apps/dist.hpp"
 #include "problem.hpp"
 
 namespace leeway::tune_cli {

@@ -10,9 +10,9 @@
 
 #include "cli/common.hpp"
 #include "distribute.hpp"
-#include "leeway/error.hpp"
-#include "leeway/file_io.hpp"
-#include "leeway/mujoco_util.hpp"
+#include "leeway/core/error.hpp"
+#include "leeway/core/file_io.hpp"
+#include "leeway/core/mujoco_util.hpp"
 #include "problem.hpp"
 #include "stages.hpp"
 

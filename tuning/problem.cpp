@@ -11,9 +11,9 @@
 #include <thread>
 
 #include "cli/common.hpp"
-#include "json_io.hpp"
-#include "leeway/file_io.hpp"
-#include "leeway/mjcf_source.hpp"
+#include "core/json_io.hpp"
+#include "leeway/core/file_io.hpp"
+#include "leeway/core/mjcf_source.hpp"
 #include "tuner.hpp"
 
 namespace leeway::tune_cli {

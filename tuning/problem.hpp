@@ -11,12 +11,12 @@
 #include <string>
 #include <vector>
 
-#include "dist.hpp"
-#include "leeway/confidence.hpp"
-#include "leeway/error.hpp"
-#include "leeway/file_io.hpp"
-#include "leeway/tuning.hpp"
-#include "random.hpp"
+#include "apps/dist.hpp"
+#include "core/random.hpp"
+#include "leeway/apps/tuning.hpp"
+#include "leeway/core/confidence.hpp"
+#include "leeway/core/error.hpp"
+#include "leeway/core/file_io.hpp"
 
 namespace leeway::tune_cli {
 

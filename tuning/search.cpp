@@ -3,9 +3,9 @@
 #include <iomanip>
 #include <iostream>
 
+#include "apps/statistics.hpp"
 #include "distribute.hpp"
 #include "stages.hpp"
-#include "statistics.hpp"
 
 namespace leeway::tune_cli {
 

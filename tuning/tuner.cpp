@@ -8,7 +8,7 @@
 #include <map>
 #include <nlopt.hpp>
 
-#include "leeway/error.hpp"
+#include "leeway/core/error.hpp"
 
 namespace leeway::tune {
 namespace {

@@ -9,14 +9,14 @@
 #include <cstdio>
 #include <string>
 
-#include "leeway/bounds_file.hpp"
-#include "leeway/bounds_trajectory.hpp"
-#include "leeway/cell_defaults.hpp"
-#include "leeway/error.hpp"
-#include "leeway/file_io.hpp"
-#include "leeway/mujoco_util.hpp"
-#include "leeway/nominal_path.hpp"
-#include "leeway/pipeline.hpp"
+#include "leeway/core/bounds_trajectory.hpp"
+#include "leeway/core/cell_defaults.hpp"
+#include "leeway/core/error.hpp"
+#include "leeway/core/file_io.hpp"
+#include "leeway/core/mujoco_util.hpp"
+#include "leeway/core/pipeline.hpp"
+#include "leeway/io/bounds_file.hpp"
+#include "leeway/path/nominal_path.hpp"
 
 int main(int argc, char** argv) {
   using namespace leeway;

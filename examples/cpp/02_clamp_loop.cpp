@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "leeway/bounds_file.hpp"
-#include "leeway/error.hpp"
+#include "leeway/core/error.hpp"
+#include "leeway/io/bounds_file.hpp"
 
 int main(int argc, char** argv) {
   using namespace leeway;

@@ -9,10 +9,10 @@
 #include <sstream>
 #include <thread>
 
-#include "dist.hpp"
-#include "leeway/batch.hpp"
-#include "leeway/file_io.hpp"
-#include "leeway/mjcf_source.hpp"
+#include "apps/dist.hpp"
+#include "leeway/apps/batch.hpp"
+#include "leeway/core/file_io.hpp"
+#include "leeway/core/mjcf_source.hpp"
 
 namespace leeway::cli {
 namespace {

@@ -8,16 +8,16 @@
 #include <sstream>
 #include <utility>
 
-#include "leeway/bounds_file.hpp"
-#include "leeway/endpoints.hpp"
-#include "leeway/export_mjcf.hpp"
-#include "leeway/file_io.hpp"
-#include "leeway/mjcf_source.hpp"
-#include "leeway/nominal_path.hpp"
-#include "leeway/path_check.hpp"
-#include "leeway/pipeline.hpp"
-#include "leeway/planner.hpp"
-#include "leeway/room.hpp"
+#include "leeway/core/file_io.hpp"
+#include "leeway/core/mjcf_source.hpp"
+#include "leeway/core/pipeline.hpp"
+#include "leeway/core/room.hpp"
+#include "leeway/io/bounds_file.hpp"
+#include "leeway/path/endpoints.hpp"
+#include "leeway/path/nominal_path.hpp"
+#include "leeway/path/path_check.hpp"
+#include "leeway/path/planner.hpp"
+#include "leeway/viz/export_mjcf.hpp"
 
 namespace leeway::cli {
 namespace {

@@ -5,7 +5,7 @@
 #include <string>
 
 #include "cli/common.hpp"
-#include "leeway/planner.hpp"
+#include "leeway/path/planner.hpp"
 
 namespace leeway::cli {
 

@@ -3,7 +3,7 @@
 #include <iomanip>
 #include <iostream>
 
-#include "leeway/bounds_file.hpp"
+#include "leeway/io/bounds_file.hpp"
 
 namespace leeway::cli {
 

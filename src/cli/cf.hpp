@@ -5,7 +5,7 @@
 #include <string>
 
 #include "cli/common.hpp"
-#include "leeway/confidence.hpp"
+#include "leeway/core/confidence.hpp"
 
 namespace leeway::cli {
 

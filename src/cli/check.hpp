@@ -5,7 +5,7 @@
 #include <string>
 
 #include "cli/common.hpp"
-#include "leeway/check.hpp"
+#include "leeway/core/check.hpp"
 
 namespace leeway::cli {
 

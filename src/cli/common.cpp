@@ -14,12 +14,12 @@
 #include <thread>
 #include <tuple>
 
-#include "json_io.hpp"
-#include "leeway/cell_defaults.hpp"
-#include "leeway/endpoints.hpp"
-#include "leeway/file_io.hpp"
-#include "leeway/pipeline.hpp"
-#include "leeway/planner.hpp"
+#include "core/json_io.hpp"
+#include "leeway/core/cell_defaults.hpp"
+#include "leeway/core/file_io.hpp"
+#include "leeway/core/pipeline.hpp"
+#include "leeway/path/endpoints.hpp"
+#include "leeway/path/planner.hpp"
 
 namespace leeway::cli {
 

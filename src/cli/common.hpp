@@ -21,12 +21,12 @@
 #include <utility>
 #include <vector>
 
-#include "leeway/endpoints.hpp"
-#include "leeway/error.hpp"
-#include "leeway/nominal_path.hpp"
-#include "leeway/params.hpp"
-#include "leeway/planner.hpp"
-#include "leeway/scene.hpp"
+#include "leeway/core/error.hpp"
+#include "leeway/core/params.hpp"
+#include "leeway/core/scene.hpp"
+#include "leeway/path/endpoints.hpp"
+#include "leeway/path/nominal_path.hpp"
+#include "leeway/path/planner.hpp"
 
 namespace leeway::cli {
 

@@ -2,7 +2,7 @@
 
 #include <iostream>
 
-#include "leeway/kinematics.hpp"
+#include "leeway/core/kinematics.hpp"
 
 namespace leeway::cli {
 namespace {

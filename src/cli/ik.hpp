@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "cli/common.hpp"
-#include "leeway/kinematics.hpp"
+#include "leeway/core/kinematics.hpp"
 
 namespace leeway::cli {
 

@@ -4,9 +4,9 @@
 #include <iostream>
 
 #include "cli/common.hpp"
-#include "leeway/error.hpp"
-#include "leeway/file_io.hpp"
-#include "leeway/urdf_import.hpp"
+#include "leeway/core/error.hpp"
+#include "leeway/core/file_io.hpp"
+#include "leeway/io/urdf_import.hpp"
 
 namespace leeway::cli {
 

@@ -4,9 +4,9 @@
 #include <iostream>
 
 #include "cli/common.hpp"
-#include "leeway/error.hpp"
-#include "leeway/file_io.hpp"
-#include "leeway/new_cell.hpp"
+#include "leeway/core/error.hpp"
+#include "leeway/core/file_io.hpp"
+#include "leeway/io/new_cell.hpp"
 
 namespace leeway::cli {
 

@@ -2,7 +2,7 @@
 
 #include <iostream>
 
-#include "leeway/cell_defaults.hpp"
+#include "leeway/core/cell_defaults.hpp"
 
 namespace leeway::cli {
 

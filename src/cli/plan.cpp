@@ -3,12 +3,12 @@
 #include <iomanip>
 #include <iostream>
 
-#include "leeway/endpoints.hpp"
-#include "leeway/file_io.hpp"
-#include "leeway/mjcf_source.hpp"
-#include "leeway/nominal_path.hpp"
-#include "leeway/path_check.hpp"
-#include "leeway/planner.hpp"
+#include "leeway/core/file_io.hpp"
+#include "leeway/core/mjcf_source.hpp"
+#include "leeway/path/endpoints.hpp"
+#include "leeway/path/nominal_path.hpp"
+#include "leeway/path/path_check.hpp"
+#include "leeway/path/planner.hpp"
 
 namespace leeway::cli {
 

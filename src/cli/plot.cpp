@@ -3,8 +3,8 @@
 #include <filesystem>
 #include <iostream>
 
-#include "leeway/file_io.hpp"
-#include "leeway/render.hpp"
+#include "leeway/core/file_io.hpp"
+#include "leeway/viz/render.hpp"
 
 namespace leeway::cli {
 

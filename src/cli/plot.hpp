@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "cli/common.hpp"
-#include "leeway/plot.hpp"
+#include "leeway/viz/plot.hpp"
 
 namespace leeway::cli {
 

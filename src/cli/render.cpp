@@ -3,12 +3,12 @@
 #include <cmath>
 #include <iostream>
 
-#include "leeway/file_io.hpp"
-#include "leeway/mjcf_source.hpp"
-#include "leeway/nominal_path.hpp"
-#include "leeway/path_check.hpp"
-#include "leeway/pipeline.hpp"
-#include "leeway/render.hpp"
+#include "leeway/core/file_io.hpp"
+#include "leeway/core/mjcf_source.hpp"
+#include "leeway/core/pipeline.hpp"
+#include "leeway/path/nominal_path.hpp"
+#include "leeway/path/path_check.hpp"
+#include "leeway/viz/render.hpp"
 
 namespace leeway::cli {
 namespace {

@@ -4,10 +4,10 @@
 #include <iostream>
 #include <optional>
 
-#include "leeway/bounds_export.hpp"
-#include "leeway/bounds_file.hpp"
-#include "leeway/file_io.hpp"
-#include "leeway/mjcf_source.hpp"
+#include "leeway/core/file_io.hpp"
+#include "leeway/core/mjcf_source.hpp"
+#include "leeway/io/bounds_export.hpp"
+#include "leeway/io/bounds_file.hpp"
 
 namespace leeway::cli {
 

@@ -11,10 +11,10 @@
 #include <optional>
 #include <sstream>
 
-#include "leeway/bounds_file.hpp"
-#include "leeway/file_io.hpp"
-#include "leeway/mjcf_source.hpp"
-#include "leeway/render.hpp"
+#include "leeway/core/file_io.hpp"
+#include "leeway/core/mjcf_source.hpp"
+#include "leeway/io/bounds_file.hpp"
+#include "leeway/viz/render.hpp"
 
 namespace leeway::cli {
 

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "cli/common.hpp"
-#include "leeway/simulate.hpp"
+#include "leeway/core/simulate.hpp"
 
 namespace leeway::cli {
 

@@ -10,12 +10,12 @@
 #include <sstream>
 
 #include "cli/plot.hpp"
-#include "leeway/file_io.hpp"
-#include "leeway/mjcf_source.hpp"
-#include "leeway/nominal_path.hpp"
-#include "leeway/path_check.hpp"
-#include "leeway/pipeline.hpp"
-#include "leeway/tuning.hpp"
+#include "leeway/apps/tuning.hpp"
+#include "leeway/core/file_io.hpp"
+#include "leeway/core/mjcf_source.hpp"
+#include "leeway/core/pipeline.hpp"
+#include "leeway/path/nominal_path.hpp"
+#include "leeway/path/path_check.hpp"
 
 namespace leeway::cli {
 

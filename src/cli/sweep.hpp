@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "cli/common.hpp"
-#include "leeway/confidence.hpp"
+#include "leeway/core/confidence.hpp"
 
 namespace leeway::cli {
 

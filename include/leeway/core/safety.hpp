@@ -1,0 +1,74 @@
+#pragma once
+//! @file safety.hpp
+//! The safety stage after Algorithms 2 and 3: shrinks the guide bounds until the whole bounded path
+//! (every waypoint box and every segment between waypoints, as leeway cf samples it) is certified
+//! free of the real obstacles, or passes an (epsilon, delta) sampling test. docs/algorithm.md.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "leeway/core/bounds.hpp"
+#include "leeway/core/certify.hpp"
+#include "leeway/core/params.hpp"
+#include "leeway/core/scene.hpp"
+
+namespace leeway {
+
+//! The outcome for one segment (waypoint k to k + 1; a one-waypoint path has one "segment").
+struct SegmentSafety {
+  bool passed = false;   //!< certified (certified mode) or sampling test passed (sampled mode)
+  long leaves = 0;       //!< certificate leaves spent on this segment, repairs included
+  int max_depth = 0;     //!< deepest subdivision
+  int shrink_steps = 0;  //!< shrink steps the repair took
+  long samples = 0;      //!< sampled mode: configurations drawn, all rounds and passes
+  int rounds =
+      0;  //!< sampled mode: sampling rounds, all passes (the last one found no collision when passed)
+  //! Certified mode: the segment's leaf budget (segment_leaf_budget) ran out. Before the segment was
+  //! proven, it is not certified and keeps its nominal values; after (while regrowing), it keeps
+  //! the bounds proven so far, narrower than the search would have made them.
+  bool budget_exhausted = false;
+};
+
+//! The certified mode's work limit per segment, in multiples of SafetyParams::max_leaves: every
+//! leaf the segment costs (probe checks, the proofs of every shrink step, the regrow's probes and
+//! slabs, its neighbours' slabs included) counts. The stage as a whole spends at most this times
+//! max_leaves times the number of segments, whatever the joint count.
+constexpr long kSegmentLeafBudgetFactor = 128;
+
+//! The leaf budget of one segment: kSegmentLeafBudgetFactor * max_leaves.
+long segment_leaf_budget(const SafetyParams& params);
+
+//! What the growth beyond the guide did (certified mode, params.grow not "none").
+struct GrowReport {
+  bool ran = false;    //!< growth ran (certified mode, some joint to grow)
+  int grown = 0;       //!< intervals (waypoint x joint) now wider than the guide's on some side
+  CertifyStats stats;  //!< certificate work of the growth (in SafetyReport::stats too)
+  double ms = 0;       //!< wall time [ms] (in SafetyReport::ms too)
+};
+
+//! What the safety stage did.
+struct SafetyReport {
+  SafetyMode mode = SafetyMode::kNone;
+  bool all_passed = true;  //!< every segment certified (or passed the sampling test)
+  std::vector<SegmentSafety> segments;
+  CertifyStats stats;            //!< certificate work, all segments
+  long samples_per_segment = 0;  //!< sampled mode: N = ceil(ln(1/delta) / epsilon)
+  double ms = 0;                 //!< wall time of the stage [ms]
+  GrowReport grow;               //!< certified mode: the growth beyond the guide
+};
+
+//! Samples one sampling round needs: N = ceil(ln(1/delta) / epsilon). Zero collisions in N uniform
+//! samples rejects, with confidence 1 - delta, a region whose collision share exceeds epsilon.
+long sampled_test_size(double epsilon, double delta);
+
+//! Runs the safety stage on `bounds` (waypoints in path order, linearly joined) in place: none
+//! returns at once; certified shrinks, joint by joint, toward the nominal values until every segment
+//! is certified; sampled until every segment passes the sampling test. Bounds never shrink below the
+//! nominal value. Deterministic. @throws InputError on bounds that do not fit the scene.
+//! `bound` selects the certificate's bound (the loose lever-arm bound is kept as a reference for tests
+//! and the benchmark). Certified mode runs segments three apart in parallel on `threads` threads;
+//! the result does not depend on the thread count.
+SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, const SafetyParams& params,
+                       CertifyBound bound = CertifyBound::kTaylor, int threads = 1);
+
+}  // namespace leeway

@@ -1,0 +1,126 @@
+#pragma once
+//! @file render.hpp
+//! Pictures of a cell: offscreen MuJoCo renders through OSMesa (no display needed) of the
+//! robot at a configuration, the generated volume as semi-transparent boxes coloured by height, and
+//! ghosts of the robot at the extremes of its intervals; PNG encoding; the volume of a bounds file.
+
+#include <Eigen/Core>
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "leeway/core/bounds.hpp"
+#include "leeway/core/box.hpp"
+#include "leeway/core/params.hpp"
+#include "leeway/core/scene.hpp"
+#include "leeway/core/volume.hpp"
+
+namespace leeway {
+
+//! An 8-bit RGB image, rows top to bottom.
+struct Image {
+  int width = 0;
+  int height = 0;
+  std::vector<unsigned char> rgb;  //!< 3 * width * height bytes
+  //! The pixel at column x, row y (row 0 at the top).
+  std::array<unsigned char, 3> at(int x, int y) const;
+};
+
+//! The image as a PNG file (8-bit RGB, no interlace, zlib-compressed; deterministic bytes).
+std::string encode_png(const Image& image);
+
+//! Reads the width and height of a PNG file's header. @throws InputError naming the file when it
+//! is not a PNG.
+std::array<int, 2> png_size(const std::string& path);
+
+//! Writes a PNG atomically (no partial file on failure). @throws InputError naming the file.
+void write_png(const std::string& path, const Image& image);
+
+//! A MuJoCo free camera: it looks at `lookat` from `distance` [m] along the direction given by
+//! `azimuth` (from world +x towards +y) and `elevation` (negative: looking down) [rad]: the camera
+//! sits at lookat - distance * (cos el cos az, cos el sin az, sin el).
+struct RenderCamera {
+  double azimuth = -2.4;                             //!< [rad]
+  double elevation = -0.9;                           //!< [rad], within [-pi/2, pi/2]
+  double distance = 8.0;                             //!< [m], > 0
+  Eigen::Vector3d lookat = Eigen::Vector3d::Zero();  //!< [m]
+};
+
+//! The default camera: at the default azimuth and elevation, looking at the middle of a cylinder
+//! standing on the floor (the reach circle `center`, `radius` [m], up to `height` [m]) from far
+//! enough that its bounding sphere fits the vertical field of view `fovy` [rad].
+RenderCamera frame_circle(const Eigen::Vector2d& center, double radius, double height, double fovy);
+
+//! Which ghosts to draw around the rendered configuration.
+enum class GhostMode {
+  kNone,     //!< none
+  kCorners,  //!< two: every joint at its lower bound, every joint at its upper bound
+  kJoints,   //!< two per joint with a non-empty interval: that joint at each bound, the others nominal
+};
+
+//! What to render and how.
+struct RenderRequest {
+  int width = 1280, height = 960;  //!< image size [pixels]
+  RenderCamera camera;
+  Eigen::VectorXd q;                    //!< the robot's configuration (robot joints in order)
+  std::vector<Box> volume;              //!< boxes drawn semi-transparent, coloured by their top's height
+  std::vector<Eigen::VectorXd> ghosts;  //!< configurations drawn as translucent robots
+  double volume_alpha = 0.45;           //!< opacity of the volume boxes
+};
+
+//! Colour of a volume box whose top is at `top` [m], on a blue-green-yellow scale (viridis-like)
+//! from 0 to `max_top` [m]; alpha is set by the caller.
+std::array<float, 3> height_colour(double top, double max_top);
+
+//! The configurations of `mode` around waypoint bounds `w` (see GhostMode).
+std::vector<Eigen::VectorXd> ghost_configurations(const WaypointBounds& w, GhostMode mode);
+
+//! Renders the scene offscreen with MuJoCo (OSMesa context, no display).
+//! @throws InputError on an image size outside 16 .. 8192 pixels, a non-finite camera or a bad q;
+//! std::runtime_error when no OpenGL context can be made.
+Image render_scene(const Scene& scene, const RenderRequest& request);
+
+//! Renders many frames of one scene through one OpenGL context (a video): the robot at q, up to two
+//! ghosts (tinted as render_scene's) and an arrow. One per thread; the scene must outlive it.
+class FrameRenderer {
+ public:
+  //! @throws InputError on a size outside 16 .. 8192 pixels or a non-finite camera;
+  //! std::runtime_error when no OpenGL context can be made.
+  FrameRenderer(const Scene& scene, int width, int height, const RenderCamera& camera);
+  ~FrameRenderer();
+  FrameRenderer(const FrameRenderer&) = delete;
+  FrameRenderer& operator=(const FrameRenderer&) = delete;
+  //! One frame: the robot at q, the ghosts, and a green arrow from `arrow_from` along `arrow` [m]
+  //! (none when `arrow` is zero).
+  Image render(const Eigen::VectorXd& q, const std::vector<Eigen::VectorXd>& ghosts,
+               const Eigen::Vector3d& arrow_from, const Eigen::Vector3d& arrow);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+//! Projects a world point [m] to pixel coordinates (column, row from the top) of an image rendered
+//! with `camera` and vertical field of view `fovy` [rad]: MuJoCo's free-camera pinhole model. Returns
+//! false when the point is behind the camera.
+bool project_point(const RenderCamera& camera, double fovy, int width, int height, const Eigen::Vector3d& p,
+                   Eigen::Vector2d& pixel);
+
+//! A bounds file with the volume it was computed against, regenerated from its nominal path and
+//! parameters (the volume is deterministic).
+struct BoundsFileVolume {
+  std::vector<WaypointBounds> bounds;
+  Params params;
+  Volume volume;
+  int recorded_boxes = -1;  //!< the file's "boxes"
+};
+
+//! Reads a bounds file written for `scene` and regenerates its volume from its nominal path and
+//! "params" (an older file without "params" gives an empty volume unless `require_volume`).
+//! @throws InputError naming the file when it was written for another cell (its "cell" names another
+//! file, or the regenerated volume has another box count than its "boxes"), or when
+//! `require_volume` and it has no "params".
+BoundsFileVolume read_bounds_volume(const std::string& path, const Scene& scene, bool require_volume = true);
+
+}  // namespace leeway

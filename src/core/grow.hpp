@@ -1,0 +1,34 @@
+#pragma once
+// Internal: the safety stage's growth beyond the guide (docs/algorithm.md, "Growing"; not public
+// API: make_safe runs it).
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "leeway/core/bounds.hpp"
+#include "leeway/core/certify.hpp"
+#include "leeway/core/params.hpp"
+#include "leeway/core/safety.hpp"
+#include "leeway/core/scene.hpp"
+
+namespace leeway {
+
+//! The joints params.grow names ("all", "none" or names separated by commas), one flag per joint.
+//! @throws InputError naming the scene and an unknown joint.
+std::vector<bool> grow_mask(const Scene& scene, const SafetyParams& params);
+
+//! params.max_half_width per joint (infinite where a joint is not named) [rad or m].
+//! @throws InputError naming the scene and an unknown joint.
+Eigen::VectorXd half_width_caps(const Scene& scene, const SafetyParams& params);
+
+//! Certified bounds (`segments` says which segments were proven) made wider, every growth proven:
+//! first every interval is capped at params.max_half_width; then, in rounds, each side of each
+//! grown joint at each waypoint whose segments are all certified is widened toward a share of the
+//! joint's one-joint free range (probe, then a certified slab, then bisection when it fails).
+//! Even waypoints, then odd ones, run in parallel on `threads` threads; the result does not depend
+//! on the thread count.
+GrowReport grow_bounds(const Scene& scene, std::vector<WaypointBounds>& bounds,
+                       const std::vector<SegmentSafety>& segments, const SafetyParams& params,
+                       const CertifyOptions& options, int threads);
+
+}  // namespace leeway

@@ -1,0 +1,441 @@
+#include "leeway/core/safety.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <random>
+
+#include "grow.hpp"
+#include "leeway/core/error.hpp"
+#include "leeway/core/kinematics.hpp"
+#include "parallel.hpp"
+#include "random.hpp"
+
+namespace leeway {
+namespace {
+
+// Extents below this are set to zero: the bound sits on the nominal value [rad or m].
+constexpr double kTinyExtent = 1e-6;
+// Shrink steps one segment may take before it is reported as not certified.
+constexpr int kMaxShrinkSteps = 400;
+// Steps that regrow one shrunk extent toward its guide value: bisection against the probe, then
+// the certificate (the probe's limit, a thin slab an eighth of the way to it, bisection; on a short
+// segment the thin slab comes first).
+constexpr int kProbeSteps = 4;
+constexpr int kRegrowSteps = 4;
+// A slab (what one regrow step adds) gets this fraction of the leaf budget: a slab that needs more
+// is not worth its cost. On a short segment (is_short) the first, thin slab is a cheap test of
+// whether growing is possible at all, which on dense paths fails in most cases: it gets less.
+constexpr long kSlabBudgetDivisor = 4;
+constexpr long kThinSlabBudgetDivisor = 16;
+// Phases of a dense path's segments (three otherwise): segments this far apart run in parallel,
+// the ones between them in order, each starting from its settled neighbour (warm start).
+constexpr size_t kDensePhases = 16;
+// On a dense path, every this many segments (and where the guide changes between a segment's ends,
+// see guide_steady), a warm-started segment regrows its end b toward the guide even when it needed
+// no shrinking: warm starts only narrow, and this lets the intervals widen again where the path
+// leaves the obstacles, between cold segments.
+constexpr size_t kWidenEvery = 4;
+// Random configurations a probe checks besides the corners.
+constexpr int kProbeSamples = 200;
+
+// The bounds as the nominal value and the extents below and above it, which shrink independently.
+struct Extents {
+  std::vector<Eigen::VectorXd> q, below, above;
+  explicit Extents(const std::vector<WaypointBounds>& b) {
+    for (const auto& w : b) {
+      q.push_back(w.q);
+      below.push_back(w.q - w.lower);
+      above.push_back(w.upper - w.q);
+    }
+  }
+  Eigen::VectorXd lower(size_t k) const { return q[k] - below[k]; }
+  Eigen::VectorXd upper(size_t k) const { return q[k] + above[k]; }
+};
+
+// At every joint, the point `from` (at waypoint a) and `to` (at waypoint b) are at most a twentieth
+// of the guide's narrower half-width plus 5 mrad (or mm) apart.
+bool moves_little(const Extents& guide, size_t a, size_t b, const Eigen::VectorXd& from,
+                  const Eigen::VectorXd& to) {
+  for (Eigen::Index i = 0; i < from.size(); ++i) {
+    const double half =
+        std::min(guide.below[a][i] + guide.above[a][i], guide.below[b][i] + guide.above[b][i]) / 2;
+    if (std::abs(to[i] - from[i]) > 0.05 * half + 0.005) return false;
+  }
+  return true;
+}
+
+// A segment of a dense path: the nominal value moves little between its ends (moves_little), so its
+// region is about the box at either end, and the boxes at its two ends can be about the same.
+bool is_short(const Extents& guide, size_t a, size_t b) {
+  return moves_little(guide, a, b, guide.q[a], guide.q[b]);
+}
+
+// The guide's intervals at the two ends are about the same: their centres move by as little as
+// is_short's nominal values. (The guide of the thesis's bisection can jump between neighbouring
+// waypoints of a dense path.)
+bool guide_steady(const Extents& guide, size_t a, size_t b) {
+  return moves_little(guide, a, b, (guide.lower(a) + guide.upper(a)) / 2,
+                      (guide.lower(b) + guide.upper(b)) / 2);
+}
+
+void halve(double& extent) { extent = extent / 2 < kTinyExtent ? 0.0 : extent / 2; }
+
+using detail::splitmix;
+using detail::unit;
+
+// Certified mode for the segment between waypoints a and b (a == b for a one-waypoint path).
+// Shrink: while a quick probe (exact checks of corners and samples) finds a configuration too close
+// to an obstacle, and then while the certificate fails, halve the extent of the joint blamed for it,
+// on its side of the nominal value, at the end(s) of the segment that weigh most at its path
+// parameter (then at both ends; when that extent is already zero, every extent). Regrow: every
+// shrunk extent is then bisected back toward its guide value, first against the probe (cheap),
+// then against the certificate (kRegrowSteps steps, each proving only the slab the growth adds),
+// for this segment and for the neighbouring
+// segments that share the regrown waypoint and ran before (`check_previous`, `check_next`; whether
+// they were certified: `previous_certified`, `next_certified`). `guide` holds the extents before
+// the safety stage. A segment that cannot be certified keeps only its nominal values.
+SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& guide, size_t a, size_t b,
+                              bool check_previous, bool check_next, bool previous_certified,
+                              bool next_certified, CertifyStats& total) {
+  SegmentSafety s;
+  CertifyStats stats;
+  const int n = static_cast<int>(e.q[a].size());
+  // Stretches of this segment proven free so far: valid while its bounds only shrink.
+  std::vector<std::pair<double, double>> proven;
+  auto certified = [&](size_t from, size_t to, CertifyFailure* f) {
+    return certifier.segment_free(e.lower(from), e.upper(from), e.lower(to), e.upper(to), stats, f, &proven);
+  };
+  auto probed = [&](size_t from, size_t to, CertifyFailure* f) {
+    return certifier.segment_probe(e.lower(from), e.upper(from), e.lower(to), e.upper(to), e.q[from], e.q[to],
+                                   kProbeSamples, stats, f);
+  };
+  // One shrink step for failure f; false when nothing is left to shrink.
+  auto shrink_for = [&](const CertifyFailure& f) {
+    const double tm = (f.t0 + f.t1) / 2;
+    std::vector<size_t> ends;
+    if (a == b || 1 - tm >= 0.25) ends.push_back(a);
+    if (a != b && tm >= 0.25) ends.push_back(b);
+    const int j = f.split_joint;
+    const bool above = j >= 0 && f.lower.size() == n &&
+                       (f.lower[j] + f.upper[j]) / 2 >= (1 - tm) * e.q[a][j] + tm * e.q[b][j];
+    // Halves the blamed joint's extent on its side (or, with joint < 0, every extent) at `at`.
+    auto shrink = [&](const std::vector<size_t>& at, int joint) {
+      bool any = false;
+      for (size_t k : at)
+        for (int i = 0; i < n; ++i)
+          for (int side = 0; side < 2; ++side) {
+            if (joint >= 0 && (i != joint || side != (above ? 1 : 0))) continue;
+            double& extent = side ? e.above[k][i] : e.below[k][i];
+            if (extent > 0) {
+              halve(extent);
+              any = true;
+            }
+          }
+      return any;
+    };
+    const std::vector<size_t> both = a == b ? std::vector<size_t>{a} : std::vector<size_t>{a, b};
+    return (j >= 0 && (shrink(ends, j) || shrink(both, j))) || shrink(ends, -1) || shrink(both, -1);
+  };
+  const bool short_segment = is_short(guide, a, b);
+  // Warm start: on a short segment whose end a was settled by the segment before it (an earlier
+  // phase), end b starts from end a's intervals where they are narrower than its own (clipped at
+  // its nominal value), and those are its regrow targets: a dense path's neighbouring waypoints
+  // need about the same intervals, and searching them again from the guide would repeat the
+  // failing proofs that settled end a. When end b was settled too (by the segment after it), it
+  // is narrowed the same way, and end a's regrow target is its settled value: each end's own
+  // search is over. A segment that widens (kWidenEvery) keeps the guide as end b's target.
+  Eigen::VectorXd target_below_a = guide.below[a], target_above_a = guide.above[a];
+  Eigen::VectorXd target_below_b = guide.below[b], target_above_b = guide.above[b];
+  const bool warm = short_segment && check_previous && a != b;
+  const bool widen_b = warm && !check_next && (a % kWidenEvery == 0 || !guide_steady(guide, a, b));
+  if (warm && check_next) {
+    target_below_a = e.below[a];
+    target_above_a = e.above[a];
+  }
+  if (warm) {
+    const Eigen::VectorXd lower_a = e.lower(a), upper_a = e.upper(a), lower_b = e.lower(b),
+                          upper_b = e.upper(b);
+    for (int i = 0; i < n; ++i) {
+      // (Beyond rounding only: an untouched bound keeps its exact value.)
+      if (lower_a[i] > lower_b[i] + kTinyExtent) e.below[b][i] = std::max(0.0, e.q[b][i] - lower_a[i]);
+      if (upper_a[i] < upper_b[i] - kTinyExtent) e.above[b][i] = std::max(0.0, upper_a[i] - e.q[b][i]);
+    }
+    if (!widen_b) {
+      target_below_b = e.below[b];
+      target_above_b = e.above[b];
+    }
+  }
+  // Every call below counts its leaves in `stats`, which the certifier's leaf_limit (the segment's
+  // budget) caps: a call that reaches it fails with f.budget set.
+  const auto out_of_budget = [&] { return stats.leaves >= certifier.options().leaf_limit; };
+  while (s.shrink_steps < kMaxShrinkSteps) {
+    CertifyFailure f;
+    if (probed(a, b, &f) && certified(a, b, &f)) {
+      s.passed = true;
+      break;
+    }
+    if (out_of_budget()) {
+      // Shrinking further would prove nothing more: the segment is not certified.
+      s.budget_exhausted = true;
+      break;
+    }
+    ++s.shrink_steps;
+    if (!shrink_for(f)) break;  // nothing left to shrink: the nominal segment itself is not certified
+  }
+  if (!s.passed) {
+    for (size_t k : {a, b}) {
+      e.below[k].setZero();
+      e.above[k].setZero();
+    }
+  }
+  // Growing one extent (waypoint k, joint i, side) from `from` to `to` adds to a certified segment
+  // (p, r), k one of its ends, exactly the configurations whose joint i lies between the old and the
+  // new bound: at each t a box, linear in t between the two ends (at the end other than k the
+  // slab has zero width). That slab is itself a segment for the certificate, and a thin one.
+  auto slab_certified = [&](size_t p, size_t r, size_t k, int i, int side, double from, double to,
+                            long budget_divisor) {
+    std::vector<Eigen::VectorXd> lo = {e.lower(p), e.lower(r)}, hi = {e.upper(p), e.upper(r)};
+    for (size_t end = 0; end < 2; ++end) {
+      const size_t x = end ? r : p;
+      const double now = side ? e.above[x][i] : e.below[x][i];
+      const double old_extent = x == k ? from : now, new_extent = x == k ? to : now;
+      if (side) {
+        lo[end][i] = e.q[x][i] + old_extent;
+        hi[end][i] = e.q[x][i] + new_extent;
+      } else {
+        lo[end][i] = e.q[x][i] - new_extent;
+        hi[end][i] = e.q[x][i] - old_extent;
+      }
+    }
+    const CertifyOptions normal = certifier.options();
+    CertifyOptions thin = normal;
+    thin.max_leaves = std::max(64L, normal.max_leaves / budget_divisor);
+    certifier.set_options(thin);
+    // On a certified segment only the pairs joint i moves need a proof: the others stay apart over
+    // the slab (Certifier::segment_free). On a neighbour that was not certified, every pair.
+    const bool region_certified = (p == a && r == b) || (p < a ? previous_certified : next_certified);
+    const bool free = certifier.segment_free(lo[0], hi[0], lo[1], hi[1], stats, nullptr, nullptr,
+                                             region_certified ? i : -1);
+    certifier.set_options(normal);
+    return free;
+  };
+  if (s.passed && (s.shrink_steps > 0 || widen_b)) {
+    // (Without a shrink, only a widening end b has something to regrow.)
+    std::vector<size_t> ends;
+    if (s.shrink_steps > 0) ends.push_back(a);
+    if (b != a) ends.push_back(b);
+    for (int i = 0; i < n && !out_of_budget(); ++i)
+      for (size_t k : ends)
+        for (int side = 0; side < 2 && !out_of_budget(); ++side) {
+          double& extent = side ? e.above[k][i] : e.below[k][i];
+          const double shrunk_to = extent,
+                       guide_extent = k == b ? (side ? target_above_b[i] : target_below_b[i])
+                                             : (side ? target_above_a[i] : target_below_a[i]);
+          if (!(guide_extent > shrunk_to)) continue;
+          const bool previous = check_previous && k == a, next = check_next && k == b && a != b;
+          // The largest extent the probe does not reject, by bisection (cheap) ...
+          double ok = shrunk_to, bad = guide_extent;
+          extent = bad;
+          auto probe_all = [&] {
+            return probed(a, b, nullptr) && (!previous || probed(a - 1, a, nullptr)) &&
+                   (!next || probed(b, b + 1, nullptr));
+          };
+          if (probe_all()) {
+            ok = bad;
+          } else {
+            for (int step = 0; step < kProbeSteps; ++step) {
+              extent = (ok + bad) / 2;
+              const bool pass = probe_all();
+              (pass ? ok : bad) = extent;
+            }
+          }
+          // ... then the largest the certificate proves, between the shrunk value and that one:
+          // the probe's limit and a thin slab an eighth of the way to it (when the thin slab cannot
+          // be proven, the thicker ones are not either, almost always: the extent stays shrunk),
+          // then bisection. On a short segment the thin slab comes first, on a small budget: on
+          // dense paths it fails in most cases, and a failing slab costs its whole budget.
+          const double probe_limit = ok;
+          ok = shrunk_to;
+          bad = probe_limit;
+          const int thin_step = short_segment ? 0 : 1, limit_step = 1 - thin_step;
+          for (int step = 0; step < kRegrowSteps && bad - ok > kTinyExtent; ++step) {
+            extent = step == limit_step ? bad : step == thin_step ? ok + (bad - ok) / 8 : (ok + bad) / 2;
+            const long divisor =
+                short_segment && step == thin_step ? kThinSlabBudgetDivisor : kSlabBudgetDivisor;
+            // Only what the growth adds needs proving: the rest was proven with extent `ok`.
+            const bool pass = slab_certified(a, b, k, i, side, ok, extent, divisor) &&
+                              (!previous || slab_certified(a - 1, a, k, i, side, ok, extent, divisor)) &&
+                              (!next || slab_certified(b, b + 1, k, i, side, ok, extent, divisor));
+            if (pass) {
+              ok = extent;
+              if (step == limit_step) break;
+            } else {
+              bad = extent;
+              if (step == thin_step) break;
+            }
+          }
+          extent = ok;
+        }
+  }
+  // (A regrow step that ran out kept the extent it had proven: the segment stays certified.)
+  if (out_of_budget()) s.budget_exhausted = true;
+  s.leaves = stats.leaves;
+  s.max_depth = stats.max_depth;
+  total.add(stats);
+  return s;
+}
+
+// Sampled mode for one segment: rounds of N samples drawn as leeway cf draws them (t uniform, every
+// joint uniform within the interpolated bounds); a round with a collision scales every extent at
+// both ends by 0.8 and the test starts again with fresh samples.
+SegmentSafety sample_segment(RobotState& state, Extents& e, size_t a, size_t b, long n_samples,
+                             std::uint64_t seed, size_t segment) {
+  SegmentSafety s;
+  const int n = static_cast<int>(e.q[a].size());
+  bool nominal = false;  // every extent of both ends is zero
+  for (int round = 0; round < 200; ++round) {
+    ++s.rounds;
+    std::mt19937_64 rng(splitmix(seed ^ splitmix(segment * 1000003ULL + static_cast<std::uint64_t>(round))));
+    const Eigen::VectorXd la = e.lower(a), ua = e.upper(a), lb = e.lower(b), ub = e.upper(b);
+    bool hit = false;
+    Eigen::VectorXd q(n);
+    for (long k = 0; k < n_samples && !hit; ++k) {
+      const double t = a == b ? 0.0 : unit(rng);
+      detail::draw_in_segment(la, ua, lb, ub, t, rng, q);
+      ++s.samples;
+      hit = state.in_collision(q);
+    }
+    if (!hit) {
+      s.passed = true;
+      return s;
+    }
+    // Already down to the nominal segment and still hit: nothing is left to shrink.
+    if (nominal) return s;
+    nominal = true;
+    for (size_t k : {a, b})
+      for (int i = 0; i < n; ++i)
+        for (double* extent : {&e.below[k][i], &e.above[k][i]}) {
+          *extent = *extent * 0.8 < kTinyExtent ? 0.0 : *extent * 0.8;
+          nominal = nominal && *extent == 0;
+        }
+    ++s.shrink_steps;
+  }
+  return s;
+}
+
+// The certifier's options for a segment: each segment counts its leaves from zero (its own
+// CertifyStats) up to segment_leaf_budget.
+CertifyOptions certify_options(const SafetyParams& params, CertifyBound bound) {
+  CertifyOptions options;
+  options.margin = params.margin;
+  options.max_leaves = params.max_leaves;
+  options.bound = bound;
+  options.leaf_limit = kSegmentLeafBudgetFactor * static_cast<long>(params.max_leaves);
+  return options;
+}
+
+}  // namespace
+
+long segment_leaf_budget(const SafetyParams& params) {
+  return kSegmentLeafBudgetFactor * static_cast<long>(params.max_leaves);
+}
+
+long sampled_test_size(double epsilon, double delta) {
+  return static_cast<long>(std::ceil(std::log(1.0 / delta) / epsilon));
+}
+
+SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, const SafetyParams& params,
+                       CertifyBound bound, int threads) {
+  SafetyReport report;
+  report.mode = params.mode;
+  if (params.mode == SafetyMode::kNone || bounds.empty()) return report;
+  const auto t0 = std::chrono::steady_clock::now();
+  require_joint_counts(scene, bounds);
+  for (size_t k = 0; k < bounds.size(); ++k) {
+    const auto& w = bounds[k];
+    if (!(w.lower.array() <= w.q.array()).all() || !(w.q.array() <= w.upper.array()).all())
+      throw InputError("bounds of waypoint " + std::to_string(k) + " do not contain the nominal value");
+  }
+  Extents e(bounds);
+  const size_t segments = std::max<size_t>(1, bounds.size() - 1);
+  // A dense path: at least half its segments short.
+  size_t short_count = 0;
+  for (size_t s = 0; s + 1 < bounds.size(); ++s) short_count += is_short(e, s, s + 1) ? 1 : 0;
+  const bool dense = 2 * short_count >= segments && segments > 1;
+  if (params.mode == SafetyMode::kCertified) {
+    const CertifyOptions options = certify_options(params, bound);
+    const Extents guide(bounds);
+    // Segment s writes waypoints s and s + 1 and, regrowing them, reads its neighbours' (s - 1 and
+    // s + 2): segments three apart share nothing, so the segments with s % phases == phase run in
+    // parallel, phase by phase. A regrown waypoint must keep the neighbour that shares it certified
+    // when that neighbour's phase came earlier. The order does not depend on the thread count.
+    report.segments.assign(segments, SegmentSafety{});
+    std::vector<CertifyStats> stats(segments);
+    // A dense path (at least half its segments short) takes kDensePhases phases: every segment but
+    // those of phase 0 then has a settled neighbour to start warm from.
+    const size_t phases = dense ? kDensePhases : 3;
+    for (size_t phase = 0; phase < phases; ++phase) {
+      std::vector<size_t> jobs;
+      for (size_t s = phase; s < segments; s += phases) jobs.push_back(s);
+      detail::parallel_for(static_cast<int>(jobs.size()), threads, [&] {
+        auto certifier = std::make_shared<Certifier>(scene, options);
+        return [&, certifier](int i) {
+          const size_t s = jobs[static_cast<size_t>(i)];
+          const bool previous = s > 0 && phase > 0;
+          const bool next = s + 1 < segments && phase == phases - 1;
+          // The neighbours ran in earlier phases: their outcome is settled.
+          report.segments[s] = certify_segment(*certifier, e, guide, s, std::min(s + 1, bounds.size() - 1),
+                                               previous, next, previous && report.segments[s - 1].passed,
+                                               next && report.segments[s + 1].passed, stats[s]);
+        };
+      });
+    }
+    for (const auto& st : stats) report.stats.add(st);
+  } else {
+    report.samples_per_segment = sampled_test_size(params.epsilon, params.delta);
+    RobotState state(scene);
+    // A later segment's shrink also shrinks the earlier segment that shares its waypoint: repeat
+    // the pass until one pass shrinks nothing, so every segment's final region passed its test.
+    // Per segment: samples, rounds and shrink steps add up over the passes; `passed` is the last's.
+    report.segments.assign(segments, SegmentSafety{});
+    for (int pass = 0; pass < 8; ++pass) {
+      bool any_shrunk = false;
+      for (size_t s = 0; s < segments; ++s) {
+        const auto r =
+            sample_segment(state, e, s, std::min(s + 1, bounds.size() - 1), report.samples_per_segment,
+                           params.seed + static_cast<std::uint64_t>(pass), s);
+        any_shrunk = any_shrunk || r.shrink_steps > 0;
+        SegmentSafety& total = report.segments[s];
+        total.passed = r.passed;
+        total.samples += r.samples;
+        total.rounds += r.rounds;
+        total.shrink_steps += r.shrink_steps;
+      }
+      if (!any_shrunk) break;
+    }
+  }
+  for (const auto& s : report.segments) report.all_passed = report.all_passed && s.passed;
+  // Only shrunk sides are rewritten, so an untouched bound keeps its exact value.
+  const Extents original(bounds);
+  for (size_t k = 0; k < bounds.size(); ++k)
+    for (Eigen::Index i = 0; i < bounds[k].q.size(); ++i) {
+      if (e.below[k][i] != original.below[k][i]) bounds[k].lower[i] = bounds[k].q[i] - e.below[k][i];
+      if (e.above[k][i] != original.above[k][i]) bounds[k].upper[i] = bounds[k].q[i] + e.above[k][i];
+    }
+  // Growth runs on sparse paths: on a dense one it would cost several times the certified mode's
+  // work (docs/algorithm.md, "Growing"). The caps apply to every path.
+  if (params.mode == SafetyMode::kCertified && (!dense || !params.max_half_width.empty()) &&
+      (params.grow != "none" || !params.max_half_width.empty())) {
+    SafetyParams growth = params;
+    if (dense) growth.grow = "none";
+    report.grow =
+        grow_bounds(scene, bounds, report.segments, growth, certify_options(params, bound), threads);
+    report.stats.add(report.grow.stats);
+  }
+  report.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return report;
+}
+
+}  // namespace leeway

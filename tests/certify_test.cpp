@@ -1,4 +1,4 @@
-// The certificate of free joint-space regions (src/certify.cpp): random regions and segments of the
+// The certificate of free joint-space regions (src/core/certify.cpp): random regions and segments of the
 // bundled workcells against brute-force sampling with the exact clearance, and small cells whose
 // certified extents are derived by hand.
 #include "leeway/core/certify.hpp"
@@ -230,7 +230,7 @@ const char* kHammerPropertyCell = R"(<mujoco model="hammer2">
 </mujoco>
 )";
 
-// BUG (src/certify.cpp, Certifier::Certifier): Link::lever, the bound of |x - o_j| over every
+// BUG (src/core/certify.cpp, Certifier::Certifier): Link::lever, the bound of |x - o_j| over every
 // configuration, sums the chain's fixed offsets (jnt_pos, body_pos, geom_pos) but not the travel of
 // a slide joint after the hinge. Here a hinge j1 about z carries a slide s along the arm (range 0.3
 // .. 1.5 m) with a box 0.2 x 0.1 x 0.1 m at the slide's origin: every offset is 0, so lever(j1) = 0
@@ -797,7 +797,7 @@ TEST_F(CertifyTest, BadBoundsThrowInputError) {
   EXPECT_NO_THROW(certifier.region_free(hi, hi, stats));
 }
 
-// DEFECT (src/certify.cpp, Certifier::segment_probe): the nominal configurations qa, qb are not
+// DEFECT (src/core/certify.cpp, Certifier::segment_probe): the nominal configurations qa, qb are not
 // checked. A NaN nominal is accepted (the blame weights become NaN), and a nominal of the wrong size
 // goes into Eigen expressions with the bounds (silently truncated here, 7 values for 6 joints; with
 // 5 values it reads past the vector's end).
@@ -909,7 +909,7 @@ TEST_F(CertifyTest, SlideSegmentCertifiedUpToThePlate) {
   EXPECT_EQ(failure.t1, 1.0);
 }
 
-// DEFECT (src/certify.cpp, Certifier::segment_free): the path parameter is split while any joint's
+// DEFECT (src/core/certify.cpp, Certifier::segment_free): the path parameter is split while any joint's
 // motion over the stretch exceeds half its half-width ("dominated"), down to t steps of 2^-20,
 // before a leaf is tested. With zero-width bounds (the nominal path itself, or a collapsed
 // interval on a moving joint) every stretch is dominated, so certifying needs 2^20 leaves and the

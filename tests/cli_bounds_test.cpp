@@ -291,7 +291,7 @@ TEST_F(CliBoundsTest, CfBadInputsExitTwo) {
   }
 }
 
-// `bounds --max-cells 0` is taken as "not given" (src/main.cpp: `if (b_cells != 0)`), so it runs
+// `bounds --max-cells 0` is taken as "not given" (src/cli/main.cpp: `if (b_cells != 0)`), so it runs
 // with the default MAX_cells 20000 and exits 0 instead of rejecting 0. Enable once fixed.
 TEST_F(CliBoundsTest, BoundsRejectsMaxCellsZero) {
   const std::string out = (dir_.path() / "out.json").string();

@@ -281,7 +281,7 @@ TEST_F(KinematicsTest, PartialKinematicsCoversSlidesOffsetAnchorsAndFixedChildre
 // A configuration inside the Baltico patch-mould bounds of before self-collision was certified, found
 // by an independent checker (its own kinematics and separating-axis test): the wrist swings the
 // carried patch into the forearm, where MuJoCo's box-box function reports contacts 4.4 cm deep.
-// MuJoCo 2.2.2's box-box dist is half the face penetration (src/check.cpp), so the exact
+// MuJoCo 2.2.2's box-box dist is half the face penetration (src/core/check.cpp), so the exact
 // separating-axis depth that leeway reports is twice that. The patch also reaches the wrist housing.
 TEST_F(KinematicsTest, TheCarriedPatchHitsTheForearmWhereAnIndependentCheckerFoundIt) {
   const Scene scene = Scene::load(workcell("baltico"));

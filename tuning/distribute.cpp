@@ -1,5 +1,5 @@
 // leeway-tune over MPI ranks: the cases of one objective evaluation are tasks of the
-// process pool (src/dist.hpp). Every rank loads the same problem from the same command line; a task
+// process pool (src/apps/dist.hpp). Every rank loads the same problem from the same command line; a task
 // names the case, the variables and rank 0's time proxy, and its reply is the case's evaluation.
 // Numbers travel as JSON, which writes every double so that it reads back exactly: the search sees
 // the same values as in a single process.

@@ -1,6 +1,6 @@
 #pragma once
 // Internal to leeway-tune: the cases of an objective evaluation as tasks of the process pool
-// (src/dist.hpp), on one process or over MPI ranks (docs/batch.md, "leeway-tune over MPI").
+// (src/apps/dist.hpp), on one process or over MPI ranks (docs/batch.md, "leeway-tune over MPI").
 
 #include <vector>
 

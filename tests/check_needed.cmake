@@ -1,6 +1,6 @@
 # Fails when an ELF file needs a forbidden shared library: its NEEDED entries (readelf -d) are
-# matched against lib<NAME> for every NAME in FORBIDDEN. Debian's gcc links without --as-needed,
-# so NEEDED lists every shared library the target's link interface brings in.
+# matched against lib<NAME> for every NAME in FORBIDDEN. Linked with --no-as-needed, a program's
+# NEEDED lists every shared library its link interface brings in, called or not.
 #   cmake -DREADELF=readelf -DFILE=<elf> -DFORBIDDEN=OSMesa,urdfdom,mpi -P check_needed.cmake
 foreach(var READELF FILE FORBIDDEN)
   if(NOT DEFINED ${var} OR "${${var}}" STREQUAL "")

@@ -29,6 +29,7 @@
 #include "leeway/core/file_io.hpp"
 #include "leeway/core/pipeline.hpp"
 #include "leeway/path/nominal_path.hpp"
+#include "lever_bound.hpp"
 
 namespace {
 
@@ -40,9 +41,9 @@ double now_ms() {
       .count();
 }
 
-const char* bound_name(leeway::CertifyBound b) {
-  return b == leeway::CertifyBound::kTaylor ? "Taylor" : "lever";
-}
+// The two bounds compared: the Taylor bound (null: the certifier's own) and the lever reference.
+const leeway::LeverBound kLeverBound;
+const char* bound_name(const leeway::SweepBound* b) { return b ? "lever" : "Taylor"; }
 
 // Mean width over the waypoints of the joints with mask[i] set [rad or m].
 double mean_width(const std::vector<leeway::WaypointBounds>& bounds, const std::vector<bool>& mask) {
@@ -67,18 +68,19 @@ struct BoxResult {
 };
 
 BoxResult certify_boxes(const leeway::Scene& scene, const std::vector<leeway::WaypointBounds>& guide,
-                        leeway::CertifyBound bound, long budget) {
+                        const leeway::SweepBound* bound, long budget) {
   leeway::CertifyOptions options;
   options.margin = leeway::SafetyParams{}.margin;
   options.max_leaves = budget;
   options.bound = bound;
-  leeway::Certifier certifier(scene, options);
+  const leeway::Certifier certifier(scene, options);
+  leeway::CertifyContext ctx(scene);
   BoxResult r;
   const double t0 = now_ms();
   for (size_t k = 0; k < guide.size() && r.certified; ++k) {
     leeway::CertifyStats stats;
     leeway::CertifyFailure failure;
-    if (!certifier.region_free(guide[k].lower, guide[k].upper, stats, &failure)) {
+    if (!certifier.region_free(ctx, guide[k].lower, guide[k].upper, stats, &failure)) {
       r.certified = false;
       r.failed = static_cast<int>(k);
       r.reason = failure.centre_hits                        ? "collision"
@@ -173,8 +175,7 @@ int main(int argc, char** argv) {
   }
   const std::vector<std::pair<std::string, std::string>> paths = {
       {"home", "patch"}, {"patch", "mould"}, {"mould", "home"}};
-  const std::vector<leeway::CertifyBound> kinds = {leeway::CertifyBound::kTaylor,
-                                                   leeway::CertifyBound::kLever};
+  const std::vector<const leeway::SweepBound*> kinds = {nullptr, &kLeverBound};
   const double start = now_ms();
   json out;
   out["command"] = command;
@@ -253,12 +254,12 @@ int main(int argc, char** argv) {
         std::vector<int> max_leaves(kinds.size());
         for (size_t b = 0; b < kinds.size(); ++b) {
           leeway::SafetyParams sp = safety;
-          if (kinds[b] == leeway::CertifyBound::kLever) sp.max_leaves = static_cast<int>(lever_max_leaves);
+          if (kinds[b] == &kLeverBound) sp.max_leaves = static_cast<int>(lever_max_leaves);
           max_leaves[b] = sp.max_leaves;
           for (int r = 0; r < repeats; ++r) {
             safe[b] = guide;
             const double t0 = now_ms();
-            reports[b] = leeway::make_safe(scene, safe[b], sp, kinds[b]);
+            reports[b] = leeway::make_safe(scene, safe[b], sp, 1, kinds[b]);
             runs[b].push_back(now_ms() - t0);
           }
         }

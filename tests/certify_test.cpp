@@ -22,6 +22,7 @@
 #include "leeway/core/error.hpp"
 #include "leeway/core/kinematics.hpp"
 #include "leeway/core/scene.hpp"
+#include "lever_bound.hpp"
 #include "test_util.hpp"
 
 namespace leeway {
@@ -29,6 +30,10 @@ namespace {
 
 using test::one_link_cell;
 using test::workcell;
+
+// The certificate's bounds: the Taylor bound (the certifier's own) and the lever-arm reference.
+const LeverBound kLever;
+const SweepBound* const kBounds[] = {nullptr, &kLever};
 
 std::string vec_str(const Eigen::VectorXd& v) {
   std::ostringstream s;
@@ -350,6 +355,7 @@ TEST_P(CertifyPropertyTest, CertifiedRegionsAreFree) {
   CertifyOptions opt;
   opt.max_leaves = 256;
   Certifier certifier(scene, opt);
+  CertifyContext ctx(scene);
   const int count = this->count(1);
   int certified = 0, close = 0, failures = 0;
   long leaves = 0;
@@ -357,9 +363,9 @@ TEST_P(CertifyPropertyTest, CertifiedRegionsAreFree) {
     const Eigen::VectorXd c = src.centre(r % 3), h = src.half_widths();
     const Eigen::VectorXd lower = c - h, upper = c + h;
     opt.margin = kMargins[r % 4];
-    certifier.set_options(opt);
+    certifier = Certifier(scene, opt);
     CertifyStats stats;
-    if (!certifier.region_free(lower, upper, stats)) continue;
+    if (!certifier.region_free(ctx, lower, upper, stats)) continue;
     ++certified;
     leaves += stats.leaves;
     const Violation v = sample_segment(state, src, lower, upper, lower, upper, 200, opt.margin);
@@ -393,13 +399,14 @@ TEST_P(CertifyPropertyTest, LargestCertifiedBoxesAreFree) {
   CertifyOptions opt;
   opt.max_leaves = 64;
   Certifier certifier(scene, opt);
+  CertifyContext ctx(scene);
   const int count = this->count(4);
   int boxes = 0, close = 0, failures = 0;
   for (int r = 0; r < count && failures < 3; ++r) {
     const Eigen::VectorXd c = src.centre(1 + r % 2);
     opt.margin = kMargins[r % 4];
     if (exact_clearance(state, c).distance <= opt.margin) continue;
-    certifier.set_options(opt);
+    certifier = Certifier(scene, opt);
     // Half the shapes lean on a few joints (the others 30 times narrower): the sag of one turning
     // joint is then not hidden under the first-order motion of the others.
     Eigen::VectorXd h(scene.dof());
@@ -408,8 +415,8 @@ TEST_P(CertifyPropertyTest, LargestCertifiedBoxesAreFree) {
     for (const bool leaf : {true, false}) {
       auto certified = [&](double lambda) {
         CertifyStats stats;
-        return leaf ? certifier.leaf_free(c - lambda * h, c + lambda * h, stats)
-                    : certifier.region_free(c - lambda * h, c + lambda * h, stats);
+        return leaf ? certifier.leaf_free(ctx, c - lambda * h, c + lambda * h, stats)
+                    : certifier.region_free(ctx, c - lambda * h, c + lambda * h, stats);
       };
       double lo = 0, hi = 2.5;
       if (certified(hi)) continue;  // free up to 0.75 rad: nothing near
@@ -445,6 +452,7 @@ TEST_P(CertifyPropertyTest, CertifiedSegmentsAreFree) {
   CertifyOptions opt;
   opt.max_leaves = 256;
   Certifier certifier(scene, opt);
+  CertifyContext ctx(scene);
   const int count = this->count(2);
   int certified = 0, close = 0, failures = 0;
   long leaves = 0;
@@ -455,9 +463,9 @@ TEST_P(CertifyPropertyTest, CertifiedSegmentsAreFree) {
     for (int i = 0; i < cb.size(); ++i) cb[i] += src.uniform(-reach, reach);
     const Eigen::VectorXd la = ca - ha, ua = ca + ha, lb = cb - hb, ub = cb + hb;
     opt.margin = kMargins[r % 4];
-    certifier.set_options(opt);
+    certifier = Certifier(scene, opt);
     CertifyStats stats;
-    if (!certifier.segment_free(la, ua, lb, ub, stats)) continue;
+    if (!certifier.segment_free(ctx, la, ua, lb, ub, stats)) continue;
     ++certified;
     leaves += stats.leaves;
     const Violation v = sample_segment(state, src, la, ua, lb, ub, 300, opt.margin);
@@ -487,12 +495,13 @@ TEST_P(CertifyPropertyTest, GrownSlabsOfCertifiedBoxesAreFree) {
   CertifyOptions opt;
   opt.max_leaves = 256;
   Certifier certifier(scene, opt);
+  CertifyContext ctx(scene);
   const int count = this->count(4);
   int slabs = 0, close = 0, failures = 0;
   for (int r = 0; r < count && failures < 3; ++r) {
     const Eigen::VectorXd c = src.centre(1 + r % 2), h = src.half_widths();
     CertifyStats stats;
-    if (!certifier.region_free(c - h, c + h, stats)) continue;
+    if (!certifier.region_free(ctx, c - h, c + h, stats)) continue;
     const int i = static_cast<int>(src.uniform(0, scene.dof())) % scene.dof();
     const double grow = src.uniform(0, 0.3);
     Eigen::VectorXd lower = c - h, upper = c + h;
@@ -503,7 +512,7 @@ TEST_P(CertifyPropertyTest, GrownSlabsOfCertifiedBoxesAreFree) {
       upper[i] = lower[i];
       lower[i] -= grow;
     }
-    if (!certifier.segment_free(lower, upper, lower, upper, stats, nullptr, nullptr, i)) continue;
+    if (!certifier.segment_free(ctx, lower, upper, lower, upper, stats, nullptr, nullptr, i)) continue;
     ++slabs;
     const Violation v = sample_segment(state, src, lower, upper, lower, upper, 200, opt.margin);
     if (v.min_clearance < opt.margin + 0.05) ++close;
@@ -550,17 +559,19 @@ TEST_F(CertifyTest, HingeCertifiedUpToTheWallMinusTheMargin) {
   EXPECT_TRUE(state.in_collision(v1(wall_angle(0) + 1e-3)));
 
   Certifier certifier(scene);  // margin 1 mm, 16384 leaves
+  CertifyContext ctx(scene);
   const double end = wall_angle(0.001);
   CertifyStats stats;
   CertifyFailure failure;
-  EXPECT_TRUE(certifier.region_free(v1(0), v1(end - 5e-4), stats, &failure)) << stats.leaves << " leaves";
+  EXPECT_TRUE(certifier.region_free(ctx, v1(0), v1(end - 5e-4), stats, &failure))
+      << stats.leaves << " leaves";
   EXPECT_LT(stats.leaves, 1000);
   // Within the margin (0.57 mm clear) and touching: not certified, and the failure names the pair.
   for (double upper : {end + 5e-4, wall_angle(0) + 0.01}) {
     SCOPED_TRACE("upper " + std::to_string(upper));
     stats = {};
     failure = {};
-    EXPECT_FALSE(certifier.region_free(v1(0), v1(upper), stats, &failure));
+    EXPECT_FALSE(certifier.region_free(ctx, v1(0), v1(upper), stats, &failure));
     EXPECT_EQ(scene.geom_label(failure.link_geom), "link_box");
     EXPECT_EQ(scene.geom_label(failure.obstacle_geom), "wall");
     EXPECT_TRUE(failure.centre_hits);  // the configuration j1 = upper itself is within the margin
@@ -569,7 +580,7 @@ TEST_F(CertifyTest, HingeCertifiedUpToTheWallMinusTheMargin) {
   // The other side of the link is 0.5 m from the wall at t = 0: a region [-0.4, 0] is free in one
   // bound leaf, and the bound alone separates it.
   stats = {};
-  EXPECT_TRUE(certifier.leaf_free(v1(-0.4), v1(0), stats));
+  EXPECT_TRUE(certifier.leaf_free(ctx, v1(-0.4), v1(0), stats));
   EXPECT_EQ(stats.leaves, 1);
 }
 
@@ -614,17 +625,18 @@ TEST_F(CertifyTest, SlideCertifiedUpToThePlateMinusTheMargin) {
       CertifyOptions opt;
       opt.margin = margin;
       Certifier certifier(scene, opt);
+      CertifyContext ctx(scene);
       const double end = 0.8 - margin;
       CertifyStats stats;
-      EXPECT_TRUE(certifier.leaf_free(v1(-0.5), v1(end - 1e-6), stats));
+      EXPECT_TRUE(certifier.leaf_free(ctx, v1(-0.5), v1(end - 1e-6), stats));
       EXPECT_EQ(stats.leaves, 1);
-      EXPECT_TRUE(certifier.region_free(v1(-0.5), v1(end - 1e-6), stats));
+      EXPECT_TRUE(certifier.region_free(ctx, v1(-0.5), v1(end - 1e-6), stats));
       CertifyFailure failure;
-      EXPECT_FALSE(certifier.leaf_free(v1(-0.5), v1(end + 1e-6), stats, &failure));
+      EXPECT_FALSE(certifier.leaf_free(ctx, v1(-0.5), v1(end + 1e-6), stats, &failure));
       EXPECT_EQ(scene.geom_label(failure.link_geom), "carriage_box");
       EXPECT_EQ(scene.geom_label(failure.obstacle_geom), name);
       failure = {};
-      EXPECT_FALSE(certifier.region_free(v1(-0.5), v1(end + 1e-6), stats, &failure));
+      EXPECT_FALSE(certifier.region_free(ctx, v1(-0.5), v1(end + 1e-6), stats, &failure));
       EXPECT_EQ(scene.geom_label(failure.link_geom), "carriage_box");
       EXPECT_EQ(scene.geom_label(failure.obstacle_geom), name);
       EXPECT_TRUE(failure.centre_hits);
@@ -632,9 +644,10 @@ TEST_F(CertifyTest, SlideCertifiedUpToThePlateMinusTheMargin) {
     // s in [1.5, 1.6]: the carriage (x from s - 0.2 to s + 0.2) lies wholly in the stop's half-space,
     // not free; the plate it has passed (far face x = 1.1) is 0.2 m behind it, free.
     Certifier certifier(scene);
+    CertifyContext ctx(scene);
     CertifyStats stats;
-    EXPECT_EQ(certifier.leaf_free(v1(1.5), v1(1.6), stats), name == std::string("plate"));
-    EXPECT_EQ(certifier.segment_free(v1(1.5), v1(1.6), v1(1.5), v1(1.6), stats),
+    EXPECT_EQ(certifier.leaf_free(ctx, v1(1.5), v1(1.6), stats), name == std::string("plate"));
+    EXPECT_EQ(certifier.segment_free(ctx, v1(1.5), v1(1.6), v1(1.5), v1(1.6), stats),
               name == std::string("plate"));
   }
 }
@@ -671,23 +684,24 @@ TEST_F(CertifyTest, PlaneCertifiedAboveNotWhereTheLinkDips) {
   EXPECT_TRUE(state.in_collision(v1(dip_angle(0) + 1e-3)));
 
   Certifier certifier(scene);
+  CertifyContext ctx(scene);
   const double end = dip_angle(0.001);
   CertifyStats stats;
-  EXPECT_TRUE(certifier.region_free(v1(-1.0), v1(end - 5e-4), stats)) << stats.leaves << " leaves";
+  EXPECT_TRUE(certifier.region_free(ctx, v1(-1.0), v1(end - 5e-4), stats)) << stats.leaves << " leaves";
   for (double upper : {end + 5e-4, dip_angle(0) + 0.01, 1.0}) {
     SCOPED_TRACE("upper " + std::to_string(upper));
     CertifyFailure failure;
-    EXPECT_FALSE(certifier.region_free(v1(-1.0), v1(upper), stats, &failure));
+    EXPECT_FALSE(certifier.region_free(ctx, v1(-1.0), v1(upper), stats, &failure));
     EXPECT_EQ(scene.geom_label(failure.link_geom), "link_box");
     EXPECT_EQ(scene.geom_label(failure.obstacle_geom), "ground");
   }
   // A plane is a half-space, not a sheet: from t = asin(0.6) = 0.6435 on the link's centre
   // (z = 0.5 - 0.5 sin(t)) is below it, and leaves out there are not free either.
   CertifyFailure failure;
-  EXPECT_FALSE(certifier.leaf_free(v1(1.2), v1(1.3), stats, &failure));
+  EXPECT_FALSE(certifier.leaf_free(ctx, v1(1.2), v1(1.3), stats, &failure));
   EXPECT_EQ(scene.geom_label(failure.obstacle_geom), "ground");
   EXPECT_TRUE(failure.centre_hits);
-  EXPECT_FALSE(certifier.segment_free(v1(1.2), v1(1.3), v1(1.2), v1(1.3), stats));
+  EXPECT_FALSE(certifier.segment_free(ctx, v1(1.2), v1(1.3), v1(1.2), v1(1.3), stats));
 }
 
 // A long horizontal link (the one-link arm, bottom face at z = 0.45) turning about the vertical
@@ -702,31 +716,32 @@ TEST_F(CertifyTest, TaylorBoundIsTighterThanTheLeverBound) {
   const Scene scene = Scene::load(dir.write(
       "cell.xml", one_link_cell(R"(<geom name="table" type="box" size="2 2 0.2" pos="0 0 0.2"/>)")));
   CertifyOptions taylor_opt, lever_opt;
-  lever_opt.bound = CertifyBound::kLever;
+  lever_opt.bound = &kLever;
   Certifier taylor(scene, taylor_opt), lever(scene, lever_opt);
+  CertifyContext ctx(scene);
   CertifyStats t_leaf, l_leaf;
-  EXPECT_TRUE(taylor.leaf_free(v1(-1.5), v1(1.5), t_leaf));
+  EXPECT_TRUE(taylor.leaf_free(ctx, v1(-1.5), v1(1.5), t_leaf));
   EXPECT_EQ(t_leaf.leaves, 1);
-  EXPECT_FALSE(lever.leaf_free(v1(-1.5), v1(1.5), l_leaf));
+  EXPECT_FALSE(lever.leaf_free(ctx, v1(-1.5), v1(1.5), l_leaf));
   // The lever bound's largest free leaf, by hand.
   l_leaf = {};
-  EXPECT_TRUE(lever.leaf_free(v1(-0.048), v1(0.048), l_leaf));
-  EXPECT_FALSE(lever.leaf_free(v1(-0.0495), v1(0.0495), l_leaf));
+  EXPECT_TRUE(lever.leaf_free(ctx, v1(-0.048), v1(0.048), l_leaf));
+  EXPECT_FALSE(lever.leaf_free(ctx, v1(-0.0495), v1(0.0495), l_leaf));
 
   CertifyStats t_stats, l_stats;
-  EXPECT_TRUE(taylor.region_free(v1(-1.5), v1(1.5), t_stats));
-  EXPECT_TRUE(lever.region_free(v1(-1.5), v1(1.5), l_stats));
+  EXPECT_TRUE(taylor.region_free(ctx, v1(-1.5), v1(1.5), t_stats));
+  EXPECT_TRUE(lever.region_free(ctx, v1(-1.5), v1(1.5), l_stats));
   EXPECT_EQ(l_stats.leaves - t_stats.leaves, 62)
       << "taylor " << t_stats.leaves << ", lever " << l_stats.leaves;
   EXPECT_EQ(t_stats.max_depth, 0);
   EXPECT_EQ(l_stats.max_depth, 5);
   // With a budget of 32 leaves the lever bound gives up where Taylor still certifies.
   taylor_opt.max_leaves = lever_opt.max_leaves = 32;
-  taylor.set_options(taylor_opt);
-  lever.set_options(lever_opt);
+  taylor = Certifier(scene, taylor_opt);
+  lever = Certifier(scene, lever_opt);
   CertifyFailure failure;
-  EXPECT_TRUE(taylor.region_free(v1(-1.5), v1(1.5), t_stats));
-  EXPECT_FALSE(lever.region_free(v1(-1.5), v1(1.5), l_stats, &failure));
+  EXPECT_TRUE(taylor.region_free(ctx, v1(-1.5), v1(1.5), t_stats));
+  EXPECT_FALSE(lever.region_free(ctx, v1(-1.5), v1(1.5), l_stats, &failure));
   EXPECT_TRUE(failure.budget);
   EXPECT_EQ(scene.geom_label(failure.obstacle_geom), "table");
 }
@@ -748,21 +763,23 @@ TEST_F(CertifyTest, MarginDecidesAHalfMillimetreGap) {
     CertifyOptions opt;
     opt.margin = 0.001;
     Certifier certifier(*scene, opt);
+    CertifyContext ctx(*scene);
     CertifyStats stats;
     CertifyFailure failure;
-    EXPECT_FALSE(certifier.region_free(lower, upper, stats, &failure));
+    EXPECT_FALSE(certifier.region_free(ctx, lower, upper, stats, &failure));
     EXPECT_TRUE(failure.centre_hits);
-    EXPECT_FALSE(certifier.leaf_free(lower, upper, stats));
+    EXPECT_FALSE(certifier.leaf_free(ctx, lower, upper, stats));
     opt.margin = 0.0001;
-    certifier.set_options(opt);
+    certifier = Certifier(*scene, opt);
     stats = {};
-    EXPECT_TRUE(certifier.region_free(lower, upper, stats)) << stats.leaves << " leaves";
+    EXPECT_TRUE(certifier.region_free(ctx, lower, upper, stats)) << stats.leaves << " leaves";
   }
 }
 
 TEST_F(CertifyTest, BadBoundsThrowInputError) {
   const Scene scene = Scene::load(workcell("dallara"));
   Certifier certifier(scene);
+  CertifyContext ctx(scene);
   CertifyStats stats;
   const Eigen::VectorXd lo = Eigen::VectorXd::Zero(6), hi = Eigen::VectorXd::Constant(6, 0.1);
   const Eigen::VectorXd short_v = Eigen::VectorXd::Zero(5), long_v = Eigen::VectorXd::Zero(7);
@@ -786,15 +803,15 @@ TEST_F(CertifyTest, BadBoundsThrowInputError) {
     // Named references, not a structured binding: lambdas capture those only from C++20 (clang).
     const Eigen::VectorXd& l = bad[k].first;
     const Eigen::VectorXd& u = bad[k].second;
-    expect_input_error([&] { certifier.region_free(l, u, stats); }, needles[k]);
-    expect_input_error([&] { certifier.leaf_free(l, u, stats); }, needles[k]);
-    expect_input_error([&] { certifier.segment_free(l, u, lo, hi, stats); }, needles[k]);
-    expect_input_error([&] { certifier.segment_free(lo, hi, l, u, stats); }, needles[k]);
-    expect_input_error([&] { certifier.segment_probe(l, u, lo, hi, lo, hi, 4, stats); }, needles[k]);
+    expect_input_error([&] { certifier.region_free(ctx, l, u, stats); }, needles[k]);
+    expect_input_error([&] { certifier.leaf_free(ctx, l, u, stats); }, needles[k]);
+    expect_input_error([&] { certifier.segment_free(ctx, l, u, lo, hi, stats); }, needles[k]);
+    expect_input_error([&] { certifier.segment_free(ctx, lo, hi, l, u, stats); }, needles[k]);
+    expect_input_error([&] { certifier.segment_probe(ctx, l, u, lo, hi, lo, hi, 4, stats); }, needles[k]);
   }
   EXPECT_EQ(stats.leaves, 0);  // nothing was tested
   // A point (lower = upper) is a valid region.
-  EXPECT_NO_THROW(certifier.region_free(hi, hi, stats));
+  EXPECT_NO_THROW(certifier.region_free(ctx, hi, hi, stats));
 }
 
 // DEFECT (src/core/certify.cpp, Certifier::segment_probe): the nominal configurations qa, qb are not
@@ -804,14 +821,17 @@ TEST_F(CertifyTest, BadBoundsThrowInputError) {
 TEST_F(CertifyTest, SegmentProbeRejectsBadNominalConfigurations) {
   const Scene scene = Scene::load(workcell("dallara"));
   Certifier certifier(scene);
+  CertifyContext ctx(scene);
   CertifyStats stats;
   const Eigen::VectorXd q = scene.keyframe("home").q;
   const Eigen::VectorXd lo = q.array() - 0.01, hi = q.array() + 0.01;
   Eigen::VectorXd nan_q = q;
   nan_q[3] = std::nan("");
-  EXPECT_THROW(certifier.segment_probe(lo, hi, lo, hi, Eigen::VectorXd::Zero(7), q, 4, stats), InputError);
-  EXPECT_THROW(certifier.segment_probe(lo, hi, lo, hi, q, Eigen::VectorXd::Zero(7), 4, stats), InputError);
-  EXPECT_THROW(certifier.segment_probe(lo, hi, lo, hi, nan_q, q, 4, stats), InputError);
+  EXPECT_THROW(certifier.segment_probe(ctx, lo, hi, lo, hi, Eigen::VectorXd::Zero(7), q, 4, stats),
+               InputError);
+  EXPECT_THROW(certifier.segment_probe(ctx, lo, hi, lo, hi, q, Eigen::VectorXd::Zero(7), 4, stats),
+               InputError);
+  EXPECT_THROW(certifier.segment_probe(ctx, lo, hi, lo, hi, nan_q, q, 4, stats), InputError);
 }
 
 // The same call gives the same answer and the same work: the same object twice and a fresh one.
@@ -821,21 +841,23 @@ TEST_F(CertifyTest, Deterministic) {
   const Eigen::VectorXd h = Eigen::VectorXd::Constant(6, 0.03);
   CertifyOptions opt;
   opt.max_leaves = 2000;
-  auto run = [&](Certifier& c, bool segment) {
+  auto run = [&](const Certifier& c, CertifyContext& ctx, bool segment) {
     CertifyStats stats;
     CertifyFailure failure;
-    const bool ok = segment ? c.segment_free(patch - h, patch + h, mould - h, mould + h, stats, &failure)
-                            : c.region_free(patch - h, patch + h, stats, &failure);
+    const bool ok = segment ? c.segment_free(ctx, patch - h, patch + h, mould - h, mould + h, stats, &failure)
+                            : c.region_free(ctx, patch - h, patch + h, stats, &failure);
     return std::make_tuple(ok, stats.leaves, stats.pair_tests, stats.max_depth, failure.link_geom,
                            failure.obstacle_geom, failure.split_joint, failure.t0, failure.t1);
   };
   for (bool segment : {false, true}) {
     SCOPED_TRACE(segment ? "segment" : "region");
     Certifier a(scene, opt), b(scene, opt);
-    const auto first = run(a, segment);
+    CertifyContext ctx_a(scene), ctx_b(scene);
+    const auto first = run(a, ctx_a, segment);
     EXPECT_GT(std::get<1>(first), 1);  // real work, not a one-leaf answer
-    EXPECT_EQ(run(a, segment), first);
-    EXPECT_EQ(run(b, segment), first);
+    EXPECT_EQ(run(a, ctx_a, segment), first);
+    EXPECT_EQ(run(b, ctx_b, segment), first);
+    EXPECT_EQ(run(a, ctx_b, segment), first);  // a context is scratch only
   }
 }
 
@@ -872,24 +894,26 @@ TEST_F(CertifyTest, SecondOrderSagOfATurningLinkIsBounded) {
   EXPECT_NEAR(exact_clearance(state, v1(0.1)).distance, 0.89051 - 0.85, 1e-5);
   EXPECT_TRUE(state.in_collision(v1(0.3)));
   EXPECT_NEAR(state.contacts(v1(-0.3)).at(0).depth, 0.85 - 0.84503, 1e-5);
-  for (CertifyBound bound : {CertifyBound::kTaylor, CertifyBound::kLever}) {
-    SCOPED_TRACE(bound == CertifyBound::kTaylor ? "taylor" : "lever");
+  for (const SweepBound* bound : kBounds) {
+    SCOPED_TRACE(bound ? "lever" : "taylor");
     CertifyOptions opt;
     opt.bound = bound;
     Certifier certifier(scene, opt);
+    CertifyContext ctx(scene);
     CertifyStats stats;
     CertifyFailure failure;
-    EXPECT_FALSE(certifier.leaf_free(v1(-0.3), v1(0.3), stats, &failure));
+    EXPECT_FALSE(certifier.leaf_free(ctx, v1(-0.3), v1(0.3), stats, &failure));
     EXPECT_EQ(scene.geom_label(failure.obstacle_geom), "plate");
-    EXPECT_FALSE(certifier.segment_free(v1(-0.3), v1(0.3), v1(-0.3), v1(0.3), stats));
-    EXPECT_FALSE(certifier.region_free(v1(-0.3), v1(0.3), stats));
-    EXPECT_TRUE(certifier.region_free(v1(-0.1), v1(0.1), stats));
+    EXPECT_FALSE(certifier.segment_free(ctx, v1(-0.3), v1(0.3), v1(-0.3), v1(0.3), stats));
+    EXPECT_FALSE(certifier.region_free(ctx, v1(-0.3), v1(0.3), stats));
+    EXPECT_TRUE(certifier.region_free(ctx, v1(-0.1), v1(0.1), stats));
   }
   // The Taylor bound proves [-0.1, 0.1] in its one leaf (the lever bound grows the head by 0.1 *
   // (1 + 0.1225) = 0.112 m on every side: not in one leaf).
   Certifier taylor(scene);
+  CertifyContext ctx(scene);
   CertifyStats stats;
-  EXPECT_TRUE(taylor.leaf_free(v1(-0.1), v1(0.1), stats));
+  EXPECT_TRUE(taylor.leaf_free(ctx, v1(-0.1), v1(0.1), stats));
   EXPECT_EQ(stats.leaves, 1);
 }
 
@@ -900,10 +924,11 @@ TEST_F(CertifyTest, SlideSegmentCertifiedUpToThePlate) {
   test::TempDir dir;
   const Scene scene = Scene::load(dir.write("rail.xml", kRailCell));
   Certifier certifier(scene);
+  CertifyContext ctx(scene);
   CertifyStats stats;
-  EXPECT_TRUE(certifier.segment_free(v1(-0.5), v1(-0.4), v1(0.6), v1(0.799 - 1e-6), stats));
+  EXPECT_TRUE(certifier.segment_free(ctx, v1(-0.5), v1(-0.4), v1(0.6), v1(0.799 - 1e-6), stats));
   CertifyFailure failure;
-  EXPECT_FALSE(certifier.segment_free(v1(-0.5), v1(-0.4), v1(0.6), v1(0.799 + 1e-6), stats, &failure));
+  EXPECT_FALSE(certifier.segment_free(ctx, v1(-0.5), v1(-0.4), v1(0.6), v1(0.799 + 1e-6), stats, &failure));
   EXPECT_EQ(scene.geom_label(failure.link_geom), "carriage_box");
   EXPECT_EQ(scene.geom_label(failure.obstacle_geom), "plate");
   EXPECT_EQ(failure.t1, 1.0);
@@ -921,15 +946,16 @@ TEST_F(CertifyTest, NarrowBoundsSegmentIsCertifiedWithinTheBudget) {
   test::TempDir dir;
   const Scene scene = Scene::load(dir.write("rail.xml", kRailCell));
   Certifier certifier(scene);
+  CertifyContext ctx(scene);
   CertifyStats stats;
-  EXPECT_TRUE(certifier.leaf_free(v1(-0.5), v1(0.79), stats));
+  EXPECT_TRUE(certifier.leaf_free(ctx, v1(-0.5), v1(0.79), stats));
   EXPECT_EQ(stats.leaves, 1);
   for (double w : {0.0, 1e-4}) {
     SCOPED_TRACE("half-width " + std::to_string(w));
     stats = {};
     CertifyFailure failure;
     EXPECT_TRUE(
-        certifier.segment_free(v1(-0.5 - w), v1(-0.5 + w), v1(0.79 - w), v1(0.79 + w), stats, &failure))
+        certifier.segment_free(ctx, v1(-0.5 - w), v1(-0.5 + w), v1(0.79 - w), v1(0.79 + w), stats, &failure))
         << stats.leaves << " leaves, budget " << failure.budget << ", stretch t = " << failure.t0 << " .. "
         << failure.t1;
   }
@@ -946,15 +972,16 @@ TEST_F(CertifyTest, HingeBeforeASlideIsBoundedWithTheSlidesTravel) {
   EXPECT_NEAR(exact_clearance(state, (lower + upper) / 2).distance, 0.04, 1e-9);
   EXPECT_TRUE(state.in_collision(corner));
   EXPECT_NEAR(state.contacts(corner).at(0).depth, 0.86 - 0.84503, 1e-5);
-  for (CertifyBound bound : {CertifyBound::kTaylor, CertifyBound::kLever}) {
-    SCOPED_TRACE(bound == CertifyBound::kTaylor ? "taylor" : "lever");
+  for (const SweepBound* bound : kBounds) {
+    SCOPED_TRACE(bound ? "lever" : "taylor");
     CertifyOptions opt;
     opt.bound = bound;
     Certifier certifier(scene, opt);
+    CertifyContext ctx(scene);
     CertifyStats stats;
-    EXPECT_FALSE(certifier.region_free(lower, upper, stats));
-    EXPECT_FALSE(certifier.leaf_free(lower, upper, stats)) << "a colliding box certified";
-    EXPECT_FALSE(certifier.segment_free(lower, upper, lower, upper, stats))
+    EXPECT_FALSE(certifier.region_free(ctx, lower, upper, stats));
+    EXPECT_FALSE(certifier.leaf_free(ctx, lower, upper, stats)) << "a colliding box certified";
+    EXPECT_FALSE(certifier.segment_free(ctx, lower, upper, lower, upper, stats))
         << "a colliding segment certified";
   }
 }
@@ -1015,12 +1042,13 @@ TEST_F(CertifyTest, FoldingArmCertifiedUpToItsElbowTouchMinusTheMargin) {
   for (const double j1_half : {0.0, 0.3}) {
     SCOPED_TRACE("j1 half-width " + std::to_string(j1_half));
     Certifier certifier(scene);
+    CertifyContext ctx(scene);
     CertifyStats stats;
     auto certified = [&](double upper_j3) {
       Eigen::VectorXd lo(3), hi(3);
       lo << -j1_half, 1.5707963267948966, 1.2;
       hi << j1_half, 1.5707963267948966, upper_j3;
-      return certifier.region_free(lo, hi, stats);
+      return certifier.region_free(ctx, lo, hi, stats);
     };
     double lo = 1.2, hi = 2.0;
     ASSERT_TRUE(certified(lo));

@@ -166,8 +166,8 @@ TEST_F(GrowTest, GrowthDoesNotDependOnTheThreadCount) {
                                      box(v2(-0.2, 0.2), v2(-0.25, 0.15), v2(-0.15, 0.25)),
                                      box(v2(-0.4, 0.4), v2(-0.45, 0.35), v2(-0.35, 0.45))};
   std::vector<WaypointBounds> two = one;
-  make_safe(scene, one, SafetyParams{}, CertifyBound::kTaylor, 1);
-  make_safe(scene, two, SafetyParams{}, CertifyBound::kTaylor, 2);
+  make_safe(scene, one, SafetyParams{}, 1);
+  make_safe(scene, two, SafetyParams{}, 2);
   for (size_t k = 0; k < one.size(); ++k) {
     EXPECT_EQ(one[k].lower, two[k].lower);
     EXPECT_EQ(one[k].upper, two[k].upper);

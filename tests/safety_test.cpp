@@ -92,8 +92,8 @@ TEST_F(OneLinkSafetyTest, ADensePathIsCertifiedAsWideAsATwoWaypointOne) {
   std::vector<WaypointBounds> dense;
   for (int k = 0; k <= 60; ++k) dense.push_back(box_around(0.005 * k, -0.5, 2.0));
   std::vector<WaypointBounds> two_threads = dense;
-  const SafetyReport r = make_safe(*scene_, dense, SafetyParams{}, CertifyBound::kTaylor, 1);
-  make_safe(*scene_, two_threads, SafetyParams{}, CertifyBound::kTaylor, 2);
+  const SafetyReport r = make_safe(*scene_, dense, SafetyParams{}, 1);
+  make_safe(*scene_, two_threads, SafetyParams{}, 2);
   ASSERT_EQ(r.segments.size(), 60u);
   EXPECT_TRUE(r.all_passed);
   for (size_t k = 0; k < dense.size(); ++k) {
@@ -119,8 +119,8 @@ TEST_F(OneLinkSafetyTest, ADensePathWidensAgainWhereItsGuideWidens) {
   }
   const std::vector<WaypointBounds> guide = dense;
   std::vector<WaypointBounds> two_threads = dense;
-  const SafetyReport r = make_safe(*scene_, dense, SafetyParams{}, CertifyBound::kTaylor, 1);
-  make_safe(*scene_, two_threads, SafetyParams{}, CertifyBound::kTaylor, 2);
+  const SafetyReport r = make_safe(*scene_, dense, SafetyParams{}, 1);
+  make_safe(*scene_, two_threads, SafetyParams{}, 2);
   EXPECT_TRUE(r.all_passed);
   for (size_t k = 0; k < dense.size(); ++k) {
     SCOPED_TRACE(k);

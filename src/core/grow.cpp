@@ -45,9 +45,15 @@ std::vector<std::string> split_names(const std::string& text) {
 // One waypoint's growth: the certifier of this thread, the bounds (its neighbours are read only).
 class WaypointGrowth {
  public:
-  WaypointGrowth(Certifier& certifier, std::vector<WaypointBounds>& bounds, size_t k, long slab_leaves,
-                 CertifyStats& stats)
-      : certifier_(certifier), b_(bounds), k_(k), slab_leaves_(slab_leaves), stats_(stats) {
+  WaypointGrowth(const Certifier& certifier, CertifyContext& ctx, long leaf_limit,
+                 std::vector<WaypointBounds>& bounds, size_t k, long slab_leaves, CertifyStats& stats)
+      : certifier_(certifier),
+        ctx_(ctx),
+        leaf_limit_(leaf_limit),
+        b_(bounds),
+        k_(k),
+        slab_leaves_(slab_leaves),
+        stats_(stats) {
     if (k > 0) segments_.push_back({k - 1, k});
     if (k + 1 < bounds.size()) segments_.push_back({k, k + 1});
     if (bounds.size() == 1) segments_.push_back({0, 0});
@@ -109,8 +115,8 @@ class WaypointGrowth {
     set(i, side, extent);
     bool free = true;
     for (const auto& [p, r] : segments_) {
-      free = certifier_.segment_probe(b_[p].lower, b_[p].upper, b_[r].lower, b_[r].upper, b_[p].q, b_[r].q,
-                                      kProbeSamples, stats_);
+      free = certifier_.segment_probe(ctx_, b_[p].lower, b_[p].upper, b_[r].lower, b_[r].upper, b_[p].q,
+                                      b_[r].q, kProbeSamples, stats_, nullptr, leaf_limit_);
       if (!free) break;
     }
     bound = kept;
@@ -123,10 +129,7 @@ class WaypointGrowth {
   // proof there (Certifier::segment_free's grown_joint). The old bounds are taken as they are, to
   // the last bit, and the new one is what set() writes.
   bool slab_free(int i, int side, double to, long leaves) {
-    const CertifyOptions normal = certifier_.options();
-    CertifyOptions slab = normal;
-    slab.max_leaves = std::max(64L, leaves);
-    certifier_.set_options(slab);
+    const CertifyBudget slab{std::max(64L, leaves), leaf_limit_};
     bool free = true;
     for (const auto& [p, r] : segments_) {
       Eigen::VectorXd lo[2] = {b_[p].lower, b_[r].lower}, hi[2] = {b_[p].upper, b_[r].upper};
@@ -137,14 +140,15 @@ class WaypointGrowth {
         lo[end][i] = side ? old_bound : new_bound;
         hi[end][i] = side ? new_bound : old_bound;
       }
-      free = certifier_.segment_free(lo[0], hi[0], lo[1], hi[1], stats_, nullptr, nullptr, i);
+      free = certifier_.segment_free(ctx_, lo[0], hi[0], lo[1], hi[1], slab, stats_, nullptr, nullptr, i);
       if (!free) break;
     }
-    certifier_.set_options(normal);
     return free;
   }
 
-  Certifier& certifier_;
+  const Certifier& certifier_;
+  CertifyContext& ctx_;
+  const long leaf_limit_;  // this waypoint's leaf budget, across all its calls
   std::vector<WaypointBounds>& b_;
   size_t k_;
   long slab_leaves_;
@@ -228,6 +232,7 @@ GrowReport grow_bounds(const Scene& scene, std::vector<WaypointBounds>& bounds,
   std::vector<std::vector<char>> blocked(count, std::vector<char>(static_cast<size_t>(2 * n), 0));
   std::vector<CertifyStats> stats(count);
   const long slab_leaves = params.max_leaves / kSlabBudgetDivisor;
+  const Certifier certifier(scene, options);
   // Each waypoint may spend on growing as many leaves as its segments took to certify (half of each:
   // a segment has two ends), so growth about doubles the certified mode's work at most.
   // A floor of safety.max_leaves, so that a path certified at once can still grow.
@@ -244,13 +249,10 @@ GrowReport grow_bounds(const Scene& scene, std::vector<WaypointBounds>& bounds,
       for (size_t k = parity; k < count; k += 2)
         if (grows[k]) jobs.push_back(k);
       detail::parallel_for(static_cast<int>(jobs.size()), threads, [&] {
-        auto certifier = std::make_shared<Certifier>(scene, options);
-        return [&, certifier](int job) {
+        auto ctx = std::make_shared<CertifyContext>(scene);
+        return [&, ctx](int job) {
           const size_t k = jobs[static_cast<size_t>(job)];
-          CertifyOptions limited = options;
-          limited.leaf_limit = std::max(1L, budget[k]);
-          certifier->set_options(limited);
-          WaypointGrowth growth(*certifier, bounds, k, slab_leaves, stats[k]);
+          WaypointGrowth growth(certifier, *ctx, std::max(1L, budget[k]), bounds, k, slab_leaves, stats[k]);
           // Tip to base: the guide leaves the wrist least of its room.
           for (int i = n - 1; i >= 0; --i) {
             if (!mask[static_cast<size_t>(i)]) continue;

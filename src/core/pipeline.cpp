@@ -68,7 +68,7 @@ BoundsRun compute_bounds(const Scene& scene, VolumeModel& world, const std::vect
   run.ms_bounds = ms_since(t);
   for (const auto& b : run.bounds) run.checks += b.checks;
   t = std::chrono::steady_clock::now();
-  run.safety = make_safe(scene, run.bounds, params.safety, CertifyBound::kTaylor, threads);
+  run.safety = make_safe(scene, run.bounds, params.safety, threads);
   run.ms_safety = ms_since(t);
   return run;
 }

@@ -85,6 +85,13 @@ void halve(double& extent) { extent = extent / 2 < kTinyExtent ? 0.0 : extent / 
 using detail::splitmix;
 using detail::unit;
 
+// Which neighbouring segments share the segment's waypoints and ran before it (a regrown waypoint
+// must keep them certified), and whether they were certified.
+struct Neighbours {
+  bool check_previous = false, check_next = false;
+  bool previous_certified = false, next_certified = false;
+};
+
 // Certified mode for the segment between waypoints a and b (a == b for a one-waypoint path).
 // Shrink: while a quick probe (exact checks of corners and samples) finds a configuration too close
 // to an obstacle, and then while the certificate fails, halve the extent of the joint blamed for it,
@@ -92,53 +99,50 @@ using detail::unit;
 // parameter (then at both ends; when that extent is already zero, every extent). Regrow: every
 // shrunk extent is then bisected back toward its guide value, first against the probe (cheap),
 // then against the certificate (kRegrowSteps steps, each proving only the slab the growth adds),
-// for this segment and for the neighbouring
-// segments that share the regrown waypoint and ran before (`check_previous`, `check_next`; whether
-// they were certified: `previous_certified`, `next_certified`). `guide` holds the extents before
-// the safety stage. A segment that cannot be certified keeps only its nominal values.
-SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& guide, size_t a, size_t b,
-                              bool check_previous, bool check_next, bool previous_certified,
-                              bool next_certified, CertifyStats& total) {
-  SegmentSafety s;
-  CertifyStats stats;
-  const int n = static_cast<int>(e.q[a].size());
-  // Stretches of this segment proven free so far: valid while its bounds only shrink.
-  std::vector<std::pair<double, double>> proven;
-  auto certified = [&](size_t from, size_t to, CertifyFailure* f) {
-    return certifier.segment_free(e.lower(from), e.upper(from), e.lower(to), e.upper(to), stats, f, &proven);
-  };
-  auto probed = [&](size_t from, size_t to, CertifyFailure* f) {
-    return certifier.segment_probe(e.lower(from), e.upper(from), e.lower(to), e.upper(to), e.q[from], e.q[to],
-                                   kProbeSamples, stats, f);
-  };
-  // One shrink step for failure f; false when nothing is left to shrink.
-  auto shrink_for = [&](const CertifyFailure& f) {
-    const double tm = (f.t0 + f.t1) / 2;
-    std::vector<size_t> ends;
-    if (a == b || 1 - tm >= 0.25) ends.push_back(a);
-    if (a != b && tm >= 0.25) ends.push_back(b);
-    const int j = f.split_joint;
-    const bool above = j >= 0 && f.lower.size() == n &&
-                       (f.lower[j] + f.upper[j]) / 2 >= (1 - tm) * e.q[a][j] + tm * e.q[b][j];
-    // Halves the blamed joint's extent on its side (or, with joint < 0, every extent) at `at`.
-    auto shrink = [&](const std::vector<size_t>& at, int joint) {
-      bool any = false;
-      for (size_t k : at)
-        for (int i = 0; i < n; ++i)
-          for (int side = 0; side < 2; ++side) {
-            if (joint >= 0 && (i != joint || side != (above ? 1 : 0))) continue;
-            double& extent = side ? e.above[k][i] : e.below[k][i];
-            if (extent > 0) {
-              halve(extent);
-              any = true;
-            }
-          }
-      return any;
-    };
-    const std::vector<size_t> both = a == b ? std::vector<size_t>{a} : std::vector<size_t>{a, b};
-    return (j >= 0 && (shrink(ends, j) || shrink(both, j))) || shrink(ends, -1) || shrink(both, -1);
-  };
-  const bool short_segment = is_short(guide, a, b);
+// for this segment and for the neighbouring segments that share the regrown waypoint and ran
+// before. `guide` holds the extents before the safety stage. A segment that cannot be certified
+// keeps only its nominal values. Every call counts its leaves in one CertifyStats, capped by the
+// segment's budget (leaf_limit): a call that reaches it fails with f.budget set.
+class SegmentRepair {
+ public:
+  SegmentRepair(const Certifier& certifier, CertifyContext& ctx, long leaf_limit, Extents& e,
+                const Extents& guide, size_t a, size_t b, const Neighbours& nb)
+      : certifier_(certifier),
+        ctx_(ctx),
+        e_(e),
+        guide_(guide),
+        a_(a),
+        b_(b),
+        nb_(nb),
+        n_(static_cast<int>(e.q[a].size())),
+        short_(is_short(guide, a, b)) {
+    budget_ = certifier.budget();
+    budget_.leaf_limit = leaf_limit;
+  }
+
+  SegmentSafety run(CertifyStats& total) {
+    warm_start();
+    shrink_until_certified();
+    if (s_.passed && (s_.shrink_steps > 0 || widen_b_)) regrow();
+    // (A regrow step that ran out kept the extent it had proven: the segment stays certified.)
+    if (out_of_budget()) s_.budget_exhausted = true;
+    s_.leaves = stats_.leaves;
+    s_.max_depth = stats_.max_depth;
+    total.add(stats_);
+    return s_;
+  }
+
+ private:
+  bool out_of_budget() const { return stats_.leaves >= budget_.leaf_limit; }
+  bool certified(size_t from, size_t to, CertifyFailure* f) {
+    return certifier_.segment_free(ctx_, e_.lower(from), e_.upper(from), e_.lower(to), e_.upper(to), budget_,
+                                   stats_, f, &proven_);
+  }
+  bool probed(size_t from, size_t to, CertifyFailure* f) {
+    return certifier_.segment_probe(ctx_, e_.lower(from), e_.upper(from), e_.lower(to), e_.upper(to),
+                                    e_.q[from], e_.q[to], kProbeSamples, stats_, f, budget_.leaf_limit);
+  }
+
   // Warm start: on a short segment whose end a was settled by the segment before it (an earlier
   // phase), end b starts from end a's intervals where they are narrower than its own (clipped at
   // its nominal value), and those are its regrow targets: a dense path's neighbouring waypoints
@@ -146,146 +150,194 @@ SegmentSafety certify_segment(Certifier& certifier, Extents& e, const Extents& g
   // failing proofs that settled end a. When end b was settled too (by the segment after it), it
   // is narrowed the same way, and end a's regrow target is its settled value: each end's own
   // search is over. A segment that widens (kWidenEvery) keeps the guide as end b's target.
-  Eigen::VectorXd target_below_a = guide.below[a], target_above_a = guide.above[a];
-  Eigen::VectorXd target_below_b = guide.below[b], target_above_b = guide.above[b];
-  const bool warm = short_segment && check_previous && a != b;
-  const bool widen_b = warm && !check_next && (a % kWidenEvery == 0 || !guide_steady(guide, a, b));
-  if (warm && check_next) {
-    target_below_a = e.below[a];
-    target_above_a = e.above[a];
-  }
-  if (warm) {
-    const Eigen::VectorXd lower_a = e.lower(a), upper_a = e.upper(a), lower_b = e.lower(b),
-                          upper_b = e.upper(b);
-    for (int i = 0; i < n; ++i) {
+  void warm_start() {
+    const size_t a = a_, b = b_;
+    target_below_[0] = guide_.below[a];
+    target_above_[0] = guide_.above[a];
+    target_below_[1] = guide_.below[b];
+    target_above_[1] = guide_.above[b];
+    const bool warm = short_ && nb_.check_previous && a != b;
+    widen_b_ = warm && !nb_.check_next && (a % kWidenEvery == 0 || !guide_steady(guide_, a, b));
+    if (warm && nb_.check_next) {
+      target_below_[0] = e_.below[a];
+      target_above_[0] = e_.above[a];
+    }
+    if (!warm) return;
+    const Eigen::VectorXd lower_a = e_.lower(a), upper_a = e_.upper(a), lower_b = e_.lower(b),
+                          upper_b = e_.upper(b);
+    for (int i = 0; i < n_; ++i) {
       // (Beyond rounding only: an untouched bound keeps its exact value.)
-      if (lower_a[i] > lower_b[i] + kTinyExtent) e.below[b][i] = std::max(0.0, e.q[b][i] - lower_a[i]);
-      if (upper_a[i] < upper_b[i] - kTinyExtent) e.above[b][i] = std::max(0.0, upper_a[i] - e.q[b][i]);
+      if (lower_a[i] > lower_b[i] + kTinyExtent) e_.below[b][i] = std::max(0.0, e_.q[b][i] - lower_a[i]);
+      if (upper_a[i] < upper_b[i] - kTinyExtent) e_.above[b][i] = std::max(0.0, upper_a[i] - e_.q[b][i]);
     }
-    if (!widen_b) {
-      target_below_b = e.below[b];
-      target_above_b = e.above[b];
-    }
-  }
-  // Every call below counts its leaves in `stats`, which the certifier's leaf_limit (the segment's
-  // budget) caps: a call that reaches it fails with f.budget set.
-  const auto out_of_budget = [&] { return stats.leaves >= certifier.options().leaf_limit; };
-  while (s.shrink_steps < kMaxShrinkSteps) {
-    CertifyFailure f;
-    if (probed(a, b, &f) && certified(a, b, &f)) {
-      s.passed = true;
-      break;
-    }
-    if (out_of_budget()) {
-      // Shrinking further would prove nothing more: the segment is not certified.
-      s.budget_exhausted = true;
-      break;
-    }
-    ++s.shrink_steps;
-    if (!shrink_for(f)) break;  // nothing left to shrink: the nominal segment itself is not certified
-  }
-  if (!s.passed) {
-    for (size_t k : {a, b}) {
-      e.below[k].setZero();
-      e.above[k].setZero();
+    if (!widen_b_) {
+      target_below_[1] = e_.below[b];
+      target_above_[1] = e_.above[b];
     }
   }
+
+  void shrink_until_certified() {
+    while (s_.shrink_steps < kMaxShrinkSteps) {
+      CertifyFailure f;
+      if (probed(a_, b_, &f) && certified(a_, b_, &f)) {
+        s_.passed = true;
+        break;
+      }
+      if (out_of_budget()) {
+        // Shrinking further would prove nothing more: the segment is not certified.
+        s_.budget_exhausted = true;
+        break;
+      }
+      ++s_.shrink_steps;
+      if (!shrink_for(f)) break;  // nothing left to shrink: the nominal segment itself is not certified
+    }
+    if (!s_.passed)
+      for (size_t k : {a_, b_}) {
+        e_.below[k].setZero();
+        e_.above[k].setZero();
+      }
+  }
+
+  // Halves the blamed joint's extent on its side (`above`), or with joint < 0 every extent, at the
+  // waypoints `at`; false when nothing was left to halve.
+  bool shrink(const std::vector<size_t>& at, int joint, bool above) {
+    bool any = false;
+    for (size_t k : at)
+      for (int i = 0; i < n_; ++i)
+        for (int side = 0; side < 2; ++side) {
+          if (joint >= 0 && (i != joint || side != (above ? 1 : 0))) continue;
+          double& extent = side ? e_.above[k][i] : e_.below[k][i];
+          if (extent > 0) {
+            halve(extent);
+            any = true;
+          }
+        }
+    return any;
+  }
+
+  // One shrink step for failure f; false when nothing is left to shrink.
+  bool shrink_for(const CertifyFailure& f) {
+    const size_t a = a_, b = b_;
+    const double tm = (f.t0 + f.t1) / 2;
+    std::vector<size_t> ends;
+    if (a == b || 1 - tm >= 0.25) ends.push_back(a);
+    if (a != b && tm >= 0.25) ends.push_back(b);
+    const int j = f.split_joint;
+    const bool above = j >= 0 && f.lower.size() == n_ &&
+                       (f.lower[j] + f.upper[j]) / 2 >= (1 - tm) * e_.q[a][j] + tm * e_.q[b][j];
+    const std::vector<size_t> both = a == b ? std::vector<size_t>{a} : std::vector<size_t>{a, b};
+    return (j >= 0 && (shrink(ends, j, above) || shrink(both, j, above))) || shrink(ends, -1, above) ||
+           shrink(both, -1, above);
+  }
+
   // Growing one extent (waypoint k, joint i, side) from `from` to `to` adds to a certified segment
   // (p, r), k one of its ends, exactly the configurations whose joint i lies between the old and the
   // new bound: at each t a box, linear in t between the two ends (at the end other than k the
   // slab has zero width). That slab is itself a segment for the certificate, and a thin one.
-  auto slab_certified = [&](size_t p, size_t r, size_t k, int i, int side, double from, double to,
-                            long budget_divisor) {
-    std::vector<Eigen::VectorXd> lo = {e.lower(p), e.lower(r)}, hi = {e.upper(p), e.upper(r)};
+  bool slab_certified(size_t p, size_t r, size_t k, int i, int side, double from, double to,
+                      long budget_divisor) {
+    std::vector<Eigen::VectorXd> lo = {e_.lower(p), e_.lower(r)}, hi = {e_.upper(p), e_.upper(r)};
     for (size_t end = 0; end < 2; ++end) {
       const size_t x = end ? r : p;
-      const double now = side ? e.above[x][i] : e.below[x][i];
+      const double now = side ? e_.above[x][i] : e_.below[x][i];
       const double old_extent = x == k ? from : now, new_extent = x == k ? to : now;
       if (side) {
-        lo[end][i] = e.q[x][i] + old_extent;
-        hi[end][i] = e.q[x][i] + new_extent;
+        lo[end][i] = e_.q[x][i] + old_extent;
+        hi[end][i] = e_.q[x][i] + new_extent;
       } else {
-        lo[end][i] = e.q[x][i] - new_extent;
-        hi[end][i] = e.q[x][i] - old_extent;
+        lo[end][i] = e_.q[x][i] - new_extent;
+        hi[end][i] = e_.q[x][i] - old_extent;
       }
     }
-    const CertifyOptions normal = certifier.options();
-    CertifyOptions thin = normal;
-    thin.max_leaves = std::max(64L, normal.max_leaves / budget_divisor);
-    certifier.set_options(thin);
+    CertifyBudget thin = budget_;
+    thin.max_leaves = std::max(64L, budget_.max_leaves / budget_divisor);
     // On a certified segment only the pairs joint i moves need a proof: the others stay apart over
     // the slab (Certifier::segment_free). On a neighbour that was not certified, every pair.
-    const bool region_certified = (p == a && r == b) || (p < a ? previous_certified : next_certified);
-    const bool free = certifier.segment_free(lo[0], hi[0], lo[1], hi[1], stats, nullptr, nullptr,
-                                             region_certified ? i : -1);
-    certifier.set_options(normal);
-    return free;
-  };
-  if (s.passed && (s.shrink_steps > 0 || widen_b)) {
+    const bool region_certified =
+        (p == a_ && r == b_) || (p < a_ ? nb_.previous_certified : nb_.next_certified);
+    return certifier_.segment_free(ctx_, lo[0], hi[0], lo[1], hi[1], thin, stats_, nullptr, nullptr,
+                                   region_certified ? i : -1);
+  }
+
+  void regrow() {
     // (Without a shrink, only a widening end b has something to regrow.)
     std::vector<size_t> ends;
-    if (s.shrink_steps > 0) ends.push_back(a);
-    if (b != a) ends.push_back(b);
-    for (int i = 0; i < n && !out_of_budget(); ++i)
+    if (s_.shrink_steps > 0) ends.push_back(a_);
+    if (b_ != a_) ends.push_back(b_);
+    for (int i = 0; i < n_ && !out_of_budget(); ++i)
       for (size_t k : ends)
-        for (int side = 0; side < 2 && !out_of_budget(); ++side) {
-          double& extent = side ? e.above[k][i] : e.below[k][i];
-          const double shrunk_to = extent,
-                       guide_extent = k == b ? (side ? target_above_b[i] : target_below_b[i])
-                                             : (side ? target_above_a[i] : target_below_a[i]);
-          if (!(guide_extent > shrunk_to)) continue;
-          const bool previous = check_previous && k == a, next = check_next && k == b && a != b;
-          // The largest extent the probe does not reject, by bisection (cheap) ...
-          double ok = shrunk_to, bad = guide_extent;
-          extent = bad;
-          auto probe_all = [&] {
-            return probed(a, b, nullptr) && (!previous || probed(a - 1, a, nullptr)) &&
-                   (!next || probed(b, b + 1, nullptr));
-          };
-          if (probe_all()) {
-            ok = bad;
-          } else {
-            for (int step = 0; step < kProbeSteps; ++step) {
-              extent = (ok + bad) / 2;
-              const bool pass = probe_all();
-              (pass ? ok : bad) = extent;
-            }
-          }
-          // ... then the largest the certificate proves, between the shrunk value and that one:
-          // the probe's limit and a thin slab an eighth of the way to it (when the thin slab cannot
-          // be proven, the thicker ones are not either, almost always: the extent stays shrunk),
-          // then bisection. On a short segment the thin slab comes first, on a small budget: on
-          // dense paths it fails in most cases, and a failing slab costs its whole budget.
-          const double probe_limit = ok;
-          ok = shrunk_to;
-          bad = probe_limit;
-          const int thin_step = short_segment ? 0 : 1, limit_step = 1 - thin_step;
-          for (int step = 0; step < kRegrowSteps && bad - ok > kTinyExtent; ++step) {
-            extent = step == limit_step ? bad : step == thin_step ? ok + (bad - ok) / 8 : (ok + bad) / 2;
-            const long divisor =
-                short_segment && step == thin_step ? kThinSlabBudgetDivisor : kSlabBudgetDivisor;
-            // Only what the growth adds needs proving: the rest was proven with extent `ok`.
-            const bool pass = slab_certified(a, b, k, i, side, ok, extent, divisor) &&
-                              (!previous || slab_certified(a - 1, a, k, i, side, ok, extent, divisor)) &&
-                              (!next || slab_certified(b, b + 1, k, i, side, ok, extent, divisor));
-            if (pass) {
-              ok = extent;
-              if (step == limit_step) break;
-            } else {
-              bad = extent;
-              if (step == thin_step) break;
-            }
-          }
-          extent = ok;
-        }
+        for (int side = 0; side < 2 && !out_of_budget(); ++side) regrow_extent(k, i, side);
   }
-  // (A regrow step that ran out kept the extent it had proven: the segment stays certified.)
-  if (out_of_budget()) s.budget_exhausted = true;
-  s.leaves = stats.leaves;
-  s.max_depth = stats.max_depth;
-  total.add(stats);
-  return s;
-}
+
+  // The probe of this segment and of the neighbours that share waypoint k, at the extents set.
+  bool probe_all(size_t k) {
+    const bool previous = nb_.check_previous && k == a_, next = nb_.check_next && k == b_ && a_ != b_;
+    return probed(a_, b_, nullptr) && (!previous || probed(a_ - 1, a_, nullptr)) &&
+           (!next || probed(b_, b_ + 1, nullptr));
+  }
+
+  void regrow_extent(size_t k, int i, int side) {
+    double& extent = side ? e_.above[k][i] : e_.below[k][i];
+    const size_t end = k == b_ ? 1 : 0;
+    const double shrunk_to = extent, guide_extent = side ? target_above_[end][i] : target_below_[end][i];
+    if (!(guide_extent > shrunk_to)) return;
+    const bool previous = nb_.check_previous && k == a_, next = nb_.check_next && k == b_ && a_ != b_;
+    // The largest extent the probe does not reject, by bisection (cheap) ...
+    double ok = shrunk_to, bad = guide_extent;
+    extent = bad;
+    if (probe_all(k)) {
+      ok = bad;
+    } else {
+      for (int step = 0; step < kProbeSteps; ++step) {
+        extent = (ok + bad) / 2;
+        const bool pass = probe_all(k);
+        (pass ? ok : bad) = extent;
+      }
+    }
+    // ... then the largest the certificate proves, between the shrunk value and that one: the
+    // probe's limit and a thin slab an eighth of the way to it (when the thin slab cannot be
+    // proven, the thicker ones are not either, almost always: the extent stays shrunk), then
+    // bisection. On a short segment the thin slab comes first, on a small budget: on dense paths it
+    // fails in most cases, and a failing slab costs its whole budget.
+    const double probe_limit = ok;
+    ok = shrunk_to;
+    bad = probe_limit;
+    const int thin_step = short_ ? 0 : 1, limit_step = 1 - thin_step;
+    for (int step = 0; step < kRegrowSteps && bad - ok > kTinyExtent; ++step) {
+      extent = step == limit_step ? bad : step == thin_step ? ok + (bad - ok) / 8 : (ok + bad) / 2;
+      const long divisor = short_ && step == thin_step ? kThinSlabBudgetDivisor : kSlabBudgetDivisor;
+      // Only what the growth adds needs proving: the rest was proven with extent `ok`.
+      const bool pass = slab_certified(a_, b_, k, i, side, ok, extent, divisor) &&
+                        (!previous || slab_certified(a_ - 1, a_, k, i, side, ok, extent, divisor)) &&
+                        (!next || slab_certified(b_, b_ + 1, k, i, side, ok, extent, divisor));
+      if (pass) {
+        ok = extent;
+        if (step == limit_step) break;
+      } else {
+        bad = extent;
+        if (step == thin_step) break;
+      }
+    }
+    extent = ok;
+  }
+
+  const Certifier& certifier_;
+  CertifyContext& ctx_;
+  Extents& e_;
+  const Extents& guide_;
+  const size_t a_, b_;
+  const Neighbours nb_;
+  const int n_;
+  const bool short_;
+  CertifyBudget budget_;
+  SegmentSafety s_;
+  CertifyStats stats_;
+  // Stretches of this segment proven free so far: valid while its bounds only shrink.
+  std::vector<std::pair<double, double>> proven_;
+  // Regrow targets per end (0: a, 1: b).
+  Eigen::VectorXd target_below_[2], target_above_[2];
+  bool widen_b_ = false;
+};
 
 // Sampled mode for one segment: rounds of N samples drawn as leeway cf draws them (t uniform, every
 // joint uniform within the interpolated bounds); a round with a collision scales every extent at
@@ -325,14 +377,13 @@ SegmentSafety sample_segment(RobotState& state, Extents& e, size_t a, size_t b, 
   return s;
 }
 
-// The certifier's options for a segment: each segment counts its leaves from zero (its own
-// CertifyStats) up to segment_leaf_budget.
-CertifyOptions certify_options(const SafetyParams& params, CertifyBound bound) {
+// The certifier's options: each segment counts its leaves from zero (its own CertifyStats) up to
+// segment_leaf_budget, passed to each call.
+CertifyOptions certify_options(const SafetyParams& params, const SweepBound* bound) {
   CertifyOptions options;
   options.margin = params.margin;
   options.max_leaves = params.max_leaves;
   options.bound = bound;
-  options.leaf_limit = kSegmentLeafBudgetFactor * static_cast<long>(params.max_leaves);
   return options;
 }
 
@@ -347,7 +398,7 @@ long sampled_test_size(double epsilon, double delta) {
 }
 
 SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, const SafetyParams& params,
-                       CertifyBound bound, int threads) {
+                       int threads, const SweepBound* bound) {
   SafetyReport report;
   report.mode = params.mode;
   if (params.mode == SafetyMode::kNone || bounds.empty()) return report;
@@ -365,7 +416,8 @@ SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, 
   for (size_t s = 0; s + 1 < bounds.size(); ++s) short_count += is_short(e, s, s + 1) ? 1 : 0;
   const bool dense = 2 * short_count >= segments && segments > 1;
   if (params.mode == SafetyMode::kCertified) {
-    const CertifyOptions options = certify_options(params, bound);
+    const Certifier certifier(scene, certify_options(params, bound));
+    const long leaf_limit = segment_leaf_budget(params);
     const Extents guide(bounds);
     // Segment s writes waypoints s and s + 1 and, regrowing them, reads its neighbours' (s - 1 and
     // s + 2): segments three apart share nothing, so the segments with s % phases == phase run in
@@ -380,15 +432,18 @@ SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, 
       std::vector<size_t> jobs;
       for (size_t s = phase; s < segments; s += phases) jobs.push_back(s);
       detail::parallel_for(static_cast<int>(jobs.size()), threads, [&] {
-        auto certifier = std::make_shared<Certifier>(scene, options);
-        return [&, certifier](int i) {
+        auto ctx = std::make_shared<CertifyContext>(scene);
+        return [&, ctx](int i) {
           const size_t s = jobs[static_cast<size_t>(i)];
-          const bool previous = s > 0 && phase > 0;
-          const bool next = s + 1 < segments && phase == phases - 1;
+          Neighbours nb;
+          nb.check_previous = s > 0 && phase > 0;
+          nb.check_next = s + 1 < segments && phase == phases - 1;
           // The neighbours ran in earlier phases: their outcome is settled.
-          report.segments[s] = certify_segment(*certifier, e, guide, s, std::min(s + 1, bounds.size() - 1),
-                                               previous, next, previous && report.segments[s - 1].passed,
-                                               next && report.segments[s + 1].passed, stats[s]);
+          nb.previous_certified = nb.check_previous && report.segments[s - 1].passed;
+          nb.next_certified = nb.check_next && report.segments[s + 1].passed;
+          SegmentRepair repair(certifier, *ctx, leaf_limit, e, guide, s, std::min(s + 1, bounds.size() - 1),
+                               nb);
+          report.segments[s] = repair.run(stats[s]);
         };
       });
     }

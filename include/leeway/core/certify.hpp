@@ -14,25 +14,23 @@
 #include "leeway/core/box.hpp"
 #include "leeway/core/kinematics.hpp"
 #include "leeway/core/scene.hpp"
+#include "leeway/core/swept_link.hpp"
 
 namespace leeway {
 
-//! How the swept volume of a link over a joint box is bounded.
-enum class CertifyBound {
-  //! Per separating axis: the link's motion projected on the axis to first order through the
-  //! Jacobian at the box centre, plus a sound second-order remainder (the default).
-  kTaylor,
-  //! The loose reference: the link's box inflated on every side by sum_i h_i rho_i, rho_i an
-  //! upper bound of the distance from joint i's axis to the link's farthest corner.
-  kLever,
-};
-
-//! Options of the certificate.
+//! Options of the certificate, fixed for a Certifier's life.
 struct CertifyOptions {
   double margin = 0.001;    //!< required clearance [m]: a region is free when every link stays this far away
-  long max_leaves = 16384;  //!< leaf budget of one region (or one segment); beyond it: not certified
+  long max_leaves = 16384;  //!< the default leaf budget of one region (or one segment): Certifier::budget()
   int max_depth = 40;       //!< deepest subdivision of one region
-  CertifyBound bound = CertifyBound::kTaylor;
+  //! Another bound than the Taylor bound for every pair (tests and benchmarks compare the loose
+  //! lever-arm reference through it); null: the Taylor bound. Not owned: it outlives the Certifier.
+  const SweepBound* bound = nullptr;
+};
+
+//! The work one call may do, passed to each call (never stored in the certifier).
+struct CertifyBudget {
+  long max_leaves = 16384;  //!< leaf budget of this region (or segment); beyond it: not certified
   //! The caller's work limit across calls: no call lets the CertifyStats it is given count more than
   //! this many leaves (probe checks included); a call that reaches it fails with `budget` set.
   long leaf_limit = std::numeric_limits<long>::max();
@@ -62,18 +60,41 @@ struct CertifyFailure {
   double gap = 0.0;
 };
 
-//! Proves joint-space regions free against the scene's obstacles and the robot itself. One object per thread
-//! (it owns one mjData); the Scene must outlive it.
+//! The scratch one thread's certificate calls work in: one mjData (the robot at a leaf's centre)
+//! and the buffers of the swept-link bound. Any Certifier of the same Scene can use it; one per
+//! thread, and the Scene must outlive it.
+class CertifyContext {
+ public:
+  explicit CertifyContext(const Scene& scene) : scene_(&scene), state_(scene) {}
+  const Scene& scene() const { return *scene_; }
+
+ private:
+  friend class Certifier;
+  const Scene* scene_;
+  RobotState state_;
+  SweptLink sweep_;
+  Eigen::VectorXd centre_, half_;
+  std::vector<int> failing_;
+};
+
+//! Proves joint-space regions free against the scene's obstacles and the robot itself. Immutable
+//! after construction (the cell's pairs and the links' lever data): threads share one and pass
+//! each call their own CertifyContext. The Scene must outlive it.
 class Certifier {
  public:
   explicit Certifier(const Scene& scene, CertifyOptions options = {});
 
   //! True when every configuration q with lower <= q <= upper (per joint) is free: every link geom
   //! at least options.margin from every obstacle geom. Splits the box along the joint that
-  //! contributes most to a failing pair, up to the leaf budget. `failure` (optional) describes the
+  //! contributes most to a failing pair, up to the budget. `failure` (optional) describes the
   //! first leaf that could not be certified. @throws InputError on sizes, NaN, lower > upper.
-  bool region_free(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, CertifyStats& stats,
-                   CertifyFailure* failure = nullptr);
+  bool region_free(CertifyContext& ctx, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
+                   const CertifyBudget& budget, CertifyStats& stats, CertifyFailure* failure = nullptr) const;
+  //! region_free with budget().
+  bool region_free(CertifyContext& ctx, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
+                   CertifyStats& stats, CertifyFailure* failure = nullptr) const {
+    return region_free(ctx, lower, upper, budget(), stats, failure);
+  }
 
   //! True when every configuration of the segment between two bounded waypoints is free: for t in
   //! [0, 1] the joints range over [(1-t) lower_a + t lower_b, (1-t) upper_a + t upper_b] (the
@@ -89,40 +110,45 @@ class Certifier {
   //! because it is apart over the region (move the joint back to the region's bound: the pair's
   //! geometry is the same), so only the pairs it moves are proven. The caller vouches that the
   //! region is certified.
-  bool segment_free(const Eigen::VectorXd& lower_a, const Eigen::VectorXd& upper_a,
+  bool segment_free(CertifyContext& ctx, const Eigen::VectorXd& lower_a, const Eigen::VectorXd& upper_a,
+                    const Eigen::VectorXd& lower_b, const Eigen::VectorXd& upper_b,
+                    const CertifyBudget& budget, CertifyStats& stats, CertifyFailure* failure = nullptr,
+                    std::vector<std::pair<double, double>>* proven = nullptr, int grown_joint = -1) const;
+  //! segment_free with budget().
+  bool segment_free(CertifyContext& ctx, const Eigen::VectorXd& lower_a, const Eigen::VectorXd& upper_a,
                     const Eigen::VectorXd& lower_b, const Eigen::VectorXd& upper_b, CertifyStats& stats,
                     CertifyFailure* failure = nullptr,
-                    std::vector<std::pair<double, double>>* proven = nullptr, int grown_joint = -1);
+                    std::vector<std::pair<double, double>>* proven = nullptr, int grown_joint = -1) const {
+    return segment_free(ctx, lower_a, upper_a, lower_b, upper_b, budget(), stats, failure, proven,
+                        grown_joint);
+  }
 
   //! A quick necessary test, not a proof: exact checks (the margin included) of the corners and
   //! centre of the bounds at t = 0, 1/4, 1/2, 3/4, 1 and of `samples` random configurations of the
   //! segment (a fixed, seeded sequence). False, with `failure` at the first configuration that comes
   //! within the margin of an obstacle (centre_hits set, t0 = t1 = its path parameter, split_joint =
-  //! the joint whose offset from the nominal value qa..qb moves the failing link most).
-  bool segment_probe(const Eigen::VectorXd& lower_a, const Eigen::VectorXd& upper_a,
+  //! the joint whose offset from the nominal value qa..qb moves the failing link most). Each check
+  //! counts a leaf against `leaf_limit`.
+  bool segment_probe(CertifyContext& ctx, const Eigen::VectorXd& lower_a, const Eigen::VectorXd& upper_a,
                      const Eigen::VectorXd& lower_b, const Eigen::VectorXd& upper_b,
                      const Eigen::VectorXd& qa, const Eigen::VectorXd& qb, int samples, CertifyStats& stats,
-                     CertifyFailure* failure = nullptr);
+                     CertifyFailure* failure = nullptr,
+                     long leaf_limit = std::numeric_limits<long>::max()) const;
 
   //! One leaf, no subdivision: true when the bound proves the box free.
-  bool leaf_free(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, CertifyStats& stats,
-                 CertifyFailure* failure = nullptr);
+  bool leaf_free(CertifyContext& ctx, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
+                 CertifyStats& stats, CertifyFailure* failure = nullptr) const;
 
   //! How many pairs each leaf proves: (link, obstacle) pairs and robot self pairs.
   int obstacle_pair_count() const { return obstacle_pairs_; }
   int self_pair_count() const { return static_cast<int>(self_pairs_.size()); }
 
   const CertifyOptions& options() const { return options_; }
-  void set_options(const CertifyOptions& o) { options_ = o; }
+  //! The default budget: options().max_leaves per call, no limit across calls.
+  CertifyBudget budget() const { return CertifyBudget{options_.max_leaves}; }
   const Scene& scene() const { return *scene_; }
 
  private:
-  struct Link {
-    int geom = -1;
-    std::vector<int> joints;    //!< robot joint indices that move this geom, base to tip
-    std::vector<double> lever;  //!< per entry of `joints`: bound of |x - o_j| over all configurations [m]
-    double corner_lever = 0.0;  //!< per joint bound of |corner - o_j| (the loose reference) [m]
-  };
   //! A self pair: link `link` moves against robot geom `other_geom`. The link's first `shared`
   //! joints (those at or above the two geoms' deepest common body) are held at the leaf's centre;
   //! other_link (-1 when it does not move against the link's chain) likewise with other_shared.
@@ -133,30 +159,35 @@ class Certifier {
     int other_link = -1;
     int other_shared = 0;
   };
-  struct Obstacle {
-    int geom = -1;
-    Box box;
-    bool plane = false;   //!< a half-space (normal = box z axis, surface through the centre)
-    double radius = 0.0;  //!< bounding-sphere radius of the box (infinite for planes)
-  };
 
-  bool leaf_free_impl(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, std::vector<int>& pairs,
-                      CertifyStats& stats, CertifyFailure* failure, const Eigen::VectorXd* blame = nullptr);
+  void add_links(RobotState& state);
+  void add_self_pairs();
+  void index_pairs();
+  //! A self pair's other geom at the leaf's centre, grown by what its own free joints move it.
+  SweepObstacle other_geom_swept(const CertifyContext& ctx, const SelfPair& pair, const Box& at_centre) const;
+  //! Fills `failure` for the leaf's first failing pair (the blame: the joint to split).
+  void describe_failure(const CertifyContext& ctx, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
+                        const SweepObstacle& obs, bool self, const Separation& sep,
+                        const Eigen::VectorXd* blame_weights, CertifyFailure& failure) const;
+  bool leaf_free_impl(CertifyContext& ctx, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
+                      std::vector<int>& pairs, CertifyStats& stats, CertifyFailure* failure,
+                      const Eigen::VectorXd* blame_weights = nullptr) const;
   //! `pairs`: the pairs to prove at the root (all_pairs_, or a slab's pairs_moved_by_).
-  bool region_free_impl(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, CertifyStats& stats,
-                        CertifyFailure* failure, long budget, const std::vector<int>& pairs);
+  bool region_free_impl(CertifyContext& ctx, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
+                        CertifyStats& stats, CertifyFailure* failure, long max_leaves, long leaf_limit,
+                        const std::vector<int>& pairs) const;
   //! Exact tests of the box's centre and corners (random points when there are more than 256
   //! corners): false, with `failure` at the first point within the margin of an obstacle, when one
   //! is. Such a region can never be certified, however finely it is split.
-  bool probe(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, const Eigen::VectorXd& nominal,
-             CertifyStats& stats, CertifyFailure* failure);
+  bool probe(CertifyContext& ctx, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
+             const Eigen::VectorXd& nominal, long leaf_limit, CertifyStats& stats,
+             CertifyFailure* failure) const;
+  void check_context(const CertifyContext& ctx) const;
 
   const Scene* scene_;
   CertifyOptions options_;
-  RobotState state_;
-  std::vector<Link> links_;
-  std::vector<Obstacle> obstacles_;
-  std::vector<bool> prismatic_;
+  std::vector<LinkChain> links_;
+  std::vector<SweepObstacle> obstacles_;
   std::vector<SelfPair> self_pairs_;
   int obstacle_pairs_ = 0;  //!< pair indices below it are (link, obstacle), link-major; the rest self pairs
   std::vector<int> all_pairs_;  //!< every pair index

@@ -65,10 +65,10 @@ long sampled_test_size(double epsilon, double delta);
 //! returns at once; certified shrinks, joint by joint, toward the nominal values until every segment
 //! is certified; sampled until every segment passes the sampling test. Bounds never shrink below the
 //! nominal value. Deterministic. @throws InputError on bounds that do not fit the scene.
-//! `bound` selects the certificate's bound (the loose lever-arm bound is kept as a reference for tests
-//! and the benchmark). Certified mode runs segments three apart in parallel on `threads` threads;
-//! the result does not depend on the thread count.
+//! Certified mode runs segments three apart in parallel on `threads` threads; the result does not
+//! depend on the thread count. `bound` (optional) replaces the certificate's Taylor bound (tests and
+//! the benchmark compare the loose lever-arm reference through it).
 SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, const SafetyParams& params,
-                       CertifyBound bound = CertifyBound::kTaylor, int threads = 1);
+                       int threads = 1, const SweepBound* bound = nullptr);
 
 }  // namespace leeway

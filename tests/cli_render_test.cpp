@@ -64,8 +64,8 @@ class CliRenderTest : public test::MujocoTest {
 TEST_F(CliRenderTest, VolumeColourWhereAVolumeBoxProjectsAndNotWithVolumeOff) {
   const std::string b = bounds_file();
   const std::string camera = " --size 320x240 --camera 0,-1.5,14 --lookat 0,0,0";
-  const auto on =
-      run_cli("render " + workcell("dallara") + " --bounds " + b + " --out " + path("on.png") + camera);
+  const auto on = run_cli("render " + workcell("dallara") + " --bounds " + b + " --out " + path("on.png") +
+                          camera + " --volume on");
   ASSERT_EQ(on.exit_code, 0) << on.out;
   EXPECT_THAT(on.out, HasSubstr("320x240 pixels"));
   const auto off = run_cli("render " + workcell("dallara") + " --bounds " + b + " --out " + path("off.png") +
@@ -173,7 +173,8 @@ TEST_F(CliRenderTest, BadInputExitsTwoAndWritesNothing) {
       {cell + " --out " + out + " --camera 1,-2,3", "elevation -2 rad"},
       {cell + " --out " + out + " --camera 1,-1,0", "distance 0 m must be > 0"},
       {cell + " --out " + out + " --lookat 0,0,inf", "--lookat"},
-      {cell + " --out " + out + " --volume maybe", "--volume 'maybe' must be on or off"},
+      {cell + " --out " + out + " --volume maybe", "--volume 'maybe' must be fade, on or off"},
+      {cell + " --out " + out + " --frame nowhere", "--frame 'nowhere' must be robot or volume"},
       {cell + " --out " + out + " --ghosts all", "--ghosts 'all'"},
       {workcell("dallara") + " --from home --to nowhere --out " + out, "nowhere"},
       {workcell("dallara") + " --from home --to patch --waypoint 2 --out " + out,

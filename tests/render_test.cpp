@@ -157,6 +157,121 @@ TEST_F(RenderTest, VolumeBoxColoursThePixelItProjectsTo) {
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(c[static_cast<size_t>(k)], d[static_cast<size_t>(k)], 2);
 }
 
+// The one-link arm at q = 0: its base box x, y in [-0.1, 0.1], z in [0, 0.5] and its link x in
+// [0, 1], z in [0.45, 0.55]: the robot's box is [-0.1, 1] x [-0.1, 0.1] x [0, 0.55] (the floor is
+// a plane and not framed, and there is no other obstacle). The camera looks at its centre
+// (0.45, 0, 0.275) from 1.05 r / sin(fovy / 2), r half its diagonal, fovy 45 degrees (a 4:3 image:
+// the vertical field is the narrower).
+TEST_F(RenderTest, RobotFramingFitsTheRobotWorkedByHand) {
+  const Scene s = scene();
+  const Eigen::AlignedBox3d robot = robot_extent(s, {Eigen::VectorXd::Zero(1)});
+  EXPECT_TRUE(robot.min().isApprox(Eigen::Vector3d(-0.1, -0.1, 0), 1e-12)) << robot.min().transpose();
+  EXPECT_TRUE(robot.max().isApprox(Eigen::Vector3d(1, 0.1, 0.55), 1e-12)) << robot.max().transpose();
+  const Eigen::AlignedBox3d region = robot_neighbourhood(s, robot, 0.3);
+  EXPECT_TRUE(region.isApprox(robot));
+  const double fovy = s.model().vis.global.fovy * kPi / 180;
+  const RenderCamera c = frame_box(region, RenderCamera{}, fovy, 4.0 / 3.0);
+  const double r = 0.5 * std::sqrt(1.1 * 1.1 + 0.2 * 0.2 + 0.55 * 0.55);
+  EXPECT_NEAR(c.distance, 1.05 * r / std::sin(kPi / 8), 1e-9);
+  EXPECT_TRUE(c.lookat.isApprox(Eigen::Vector3d(0.45, 0, 0.275), 1e-12));
+  EXPECT_EQ(c.azimuth, RenderCamera{}.azimuth);
+  // Every corner of the robot's box projects into a 320 x 240 image, and their bounding rectangle
+  // covers at least a fifth of it.
+  double x0 = 1e9, x1 = -1e9, y0 = 1e9, y1 = -1e9;
+  for (int k = 0; k < 8; ++k) {
+    Eigen::Vector2d px;
+    ASSERT_TRUE(
+        project_point(c, fovy, 320, 240, robot.corner(static_cast<Eigen::AlignedBox3d::CornerType>(k)), px));
+    EXPECT_TRUE(px.x() >= 0 && px.x() < 320 && px.y() >= 0 && px.y() < 240) << px.transpose();
+    x0 = std::min(x0, px.x());
+    x1 = std::max(x1, px.x());
+    y0 = std::min(y0, px.y());
+    y1 = std::max(y1, px.y());
+  }
+  EXPECT_GT((x1 - x0) * (y1 - y0), 0.2 * 320 * 240) << x0 << " " << x1 << " " << y0 << " " << y1;
+}
+
+// A wide image: the horizontal field (2 atan(aspect tan(fovy / 2))) is wider, so the vertical one
+// still sets the distance; a tall one (aspect 1/2) is set by the horizontal field.
+TEST(FrameTest, TheNarrowerFieldOfViewSetsTheDistance) {
+  const Eigen::AlignedBox3d unit(Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones());
+  const double fovy = kPi / 4, r = 0.5 * std::sqrt(3.0);
+  EXPECT_NEAR(frame_box(unit, RenderCamera{}, fovy, 2.0).distance, 1.05 * r / std::sin(kPi / 8), 1e-12);
+  const double half_w = std::atan(0.5 * std::tan(kPi / 8));
+  EXPECT_NEAR(frame_box(unit, RenderCamera{}, fovy, 0.5).distance, 1.05 * r / std::sin(half_w), 1e-12);
+}
+
+// Framed on the robot, the arm is large in the picture: turning j1 by 90 degrees changes the pixels
+// of the link's two positions. The camera of --frame volume for a 1.5 m reach (frame_circle up to
+// 2.5 m) stands about 5.4 m away against 2.3 m here (1.05 r / sin(fovy / 2), r = 1.95 and 0.83 m):
+// the link covers about (5.4 / 2.3)^2 = 5.5 times fewer pixels there; at least 3 times is required.
+TEST_F(RenderTest, TurningTheFramedArmChangesManyPixels) {
+  const Scene s = scene();
+  const double fovy = s.model().vis.global.fovy * kPi / 180;
+  auto changed = [&](const RenderCamera& camera) {
+    RenderRequest r;
+    r.width = 160;
+    r.height = 120;
+    r.camera = camera;
+    r.q = Eigen::VectorXd::Zero(1);
+    const Image a = render_scene(s, r);
+    r.q[0] = kPi / 2;
+    const Image b = render_scene(s, r);
+    int n = 0;
+    for (int y = 0; y < r.height; ++y)
+      for (int x = 0; x < r.width; ++x) {
+        const auto p = a.at(x, y), q = b.at(x, y);
+        int d = 0;
+        for (int k = 0; k < 3; ++k)
+          d += std::abs(int{p[static_cast<size_t>(k)]} - int{q[static_cast<size_t>(k)]});
+        n += d > 30 ? 1 : 0;
+      }
+    return n;
+  };
+  const std::vector<Eigen::VectorXd> both = {Eigen::VectorXd::Zero(1), Eigen::VectorXd::Constant(1, kPi / 2)};
+  const RenderCamera robot =
+      frame_box(robot_neighbourhood(s, robot_extent(s, both), 0.3), RenderCamera{}, fovy, 4.0 / 3.0);
+  const RenderCamera wide = frame_circle(Eigen::Vector2d::Zero(), 1.5, 2.5, fovy);
+  const int near = changed(robot), far = changed(wide);
+  EXPECT_GT(near, 160 * 120 / 100) << near;
+  EXPECT_GT(near, 3 * far) << near << " " << far;
+}
+
+// --volume fade: a box that meets the fade region is drawn at the faded opacity, one that does not
+// at the normal one.
+TEST_F(RenderTest, VolumeBoxesAroundTheRobotAreFaded) {
+  const Scene s = scene();
+  RenderRequest r;
+  r.width = 160;
+  r.height = 120;
+  r.q = Eigen::VectorXd::Zero(1);
+  r.camera.azimuth = 0;
+  r.camera.elevation = -1.5;
+  r.camera.distance = 8;
+  r.camera.lookat = Eigen::Vector3d::Zero();
+  Box box;
+  box.center = {-1.5, 1.5, 0.25};
+  box.half_size = {0.4, 0.4, 0.25};
+  r.volume = {box};
+  const Image normal = render_scene(s, r);
+  r.fade_region = Eigen::AlignedBox3d(Eigen::Vector3d(-2, 1, 0), Eigen::Vector3d(-1, 2, 1));
+  const Image faded = render_scene(s, r);
+  r.volume.clear();
+  const Image none = render_scene(s, r);
+  Eigen::Vector2d px;
+  const double fovy = s.model().vis.global.fovy * kPi / 180;
+  ASSERT_TRUE(project_point(r.camera, fovy, r.width, r.height, {-1.5, 1.5, 0.5}, px));
+  const int x = static_cast<int>(px.x()), y = static_cast<int>(px.y());
+  // Yellow over grey: red minus blue grows with the box's opacity (0 without the box).
+  auto tint = [&](const Image& img) { return int{img.at(x, y)[0]} - int{img.at(x, y)[2]}; };
+  EXPECT_GT(tint(normal), 40);
+  EXPECT_LT(tint(faded), tint(normal) / 2) << tint(faded) << " " << tint(normal);
+  EXPECT_GT(tint(faded), tint(none)) << tint(faded) << " " << tint(none);
+  r.faded_alpha = 1.5;
+  r.volume = {box};
+  EXPECT_THROW(render_scene(s, r), InputError);
+}
+
 TEST_F(RenderTest, BadSizesCamerasAndConfigurations) {
   const Scene s = scene();
   RenderRequest r;

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The scaling of `leeway batch` from 1 to 2 MPI ranks (issue 15), for docs/batch.md.
+"""The scaling of `leeway batch` from 1 to 2 MPI ranks, for docs/batch.md.
 
 Runs the suite (default suites/thesis.json) alternately on one process and under
 `mpirun -np 2`, both with one thread per scenario, REPEATS times each; prints the wall times

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates the pictures in docs/ (issue 11), from the repository root's build:
+# Regenerates the pictures in docs/, from the repository root's build:
 #   - docs/images/dallara-home-patch-volume.png: `leeway render` of the Dallara cell at the patch with
 #     its volume and the ghosts of the robot at its bounds (the README's first picture);
 #   - docs/images/dallara-home-patch-bounds.svg: `leeway plot` of the same bounds file;

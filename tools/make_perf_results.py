@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The performance section of docs/results.md (issue 10): runs build/leeway-bench-collision (Google
+"""The performance section of docs/results.md: runs build/leeway-bench-collision (Google
 Benchmark, medians of 5 repetitions measured in one run) and writes docs/data/perf/results.json and
 docs/data/perf/section.md, which tools/make_results.py includes. Usage, from the repository root
 after a Release build:

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Scale benchmark of issue 14: leeway on inputs far larger than the thesis's.
+"""Scale benchmark: leeway on inputs far larger than the thesis's.
 
   1. `leeway bounds CELL --path P` on a joint-linear path file of N waypoints (default 1,000) at
      default settings (leeway preset, certified safety stage, all hardware threads); target <= 30 s;

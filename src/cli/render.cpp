@@ -13,8 +13,12 @@
 namespace leeway::cli {
 namespace {
 
-// Height [m] the default camera frames without a volume (an industrial arm's reach upwards).
+// Height [m] --frame volume frames without a volume (an industrial arm's reach upwards).
 constexpr double kRobotHeight = 2.5;
+// --frame robot: obstacles within this of the robot's box [m] are framed with it.
+constexpr double kNearObstacles = 0.3;
+// --volume fade: volume boxes within this of the robot's box [m] are drawn nearly clear.
+constexpr double kFadeMargin = 0.05;
 
 // The robot's base on the floor at q: the first hinge joint's anchor (the reach circle's centre).
 Eigen::Vector2d arm_base(const Scene& scene, const Eigen::VectorXd& q) {
@@ -54,13 +58,19 @@ CLI::App* add_render(CLI::App& app, RenderArgs& args) {
           ""));
   sub->add_option("--camera", args.camera,
                   "Camera \"az,el,dist\": azimuth and elevation [rad] (elevation < 0 looks down), distance\n"
-                  "[m] (default: -2.4,-0.9 and a distance that frames the reach circle)")
+                  "[m] (default: -2.4,-0.9 and the distance --frame gives)")
       ->check(non_empty_check("three numbers az,el,dist"));
   sub->add_option("--lookat", args.lookat,
-                  "Point the camera looks at, \"x,y,z\" [m] (default: the reach circle's centre)")
+                  "Point the camera looks at, \"x,y,z\" [m] (default: the centre --frame gives)")
       ->check(non_empty_check("three numbers x,y,z"));
   sub->add_option("--size", args.size, "Image size WIDTHxHEIGHT [pixels]")->capture_default_str();
-  sub->add_option("--volume", args.volume, "Draw the volume: on or off (the thesis's fig. 3.4 after/before)")
+  sub->add_option("--volume", args.volume,
+                  "Draw the volume: fade (boxes around the robot nearly clear, so that it stays visible),\n"
+                  "on (every box alike) or off (the thesis's fig. 3.4 after/before)")
+      ->capture_default_str();
+  sub->add_option("--frame", args.frame,
+                  "Default camera: robot (the robot, its ghosts and the obstacles near them) or volume\n"
+                  "(the height-map's square up to its highest box, or the reach circle without a volume)")
       ->capture_default_str();
   sub->add_option("--ghosts", args.ghosts,
                   "Ghosts of the robot: corners (all joints at their lower, all at their upper bound),\n"
@@ -115,8 +125,10 @@ int run_render(const RenderArgs& args) {
   inputs.insert(inputs.end(), {args.bounds, args.params});
   require_outputs({{args.out, "--out", {".png"}}}, inputs);
   const auto [width, height] = parse_size(args.size, "--size");
-  if (args.volume != "on" && args.volume != "off")
-    throw InputError("--volume '" + args.volume + "' must be on or off");
+  if (args.volume != "fade" && args.volume != "on" && args.volume != "off")
+    throw InputError("--volume '" + args.volume + "' must be fade, on or off");
+  if (args.frame != "robot" && args.frame != "volume")
+    throw InputError("--frame '" + args.frame + "' must be robot or volume");
   const GhostMode ghosts = parse_ghosts(args.ghosts);
   const bool camera_given = !args.camera.empty();
   RenderCamera camera = camera_given ? parse_camera(args.camera) : RenderCamera{};
@@ -141,7 +153,7 @@ int run_render(const RenderArgs& args) {
   if (args.max_cells_given) p.height_map.max_cells = args.max_cells;
   p.validate();
   apply_joint_bounds_options(scene, args.joints, p);
-  const bool show_volume = args.volume == "on";
+  const bool show_volume = args.volume != "off";
 
   std::vector<WaypointBounds> bounds;
   Volume volume;
@@ -193,12 +205,22 @@ int run_render(const RenderArgs& args) {
     request.ghosts = ghost_configurations(bounds[static_cast<size_t>(k)], ghosts);
   }
   if (show_volume) request.volume = volume.boxes;
+  std::vector<Eigen::VectorXd> shown = request.ghosts;
+  shown.push_back(request.q);
+  const Eigen::AlignedBox3d robot = robot_extent(scene, shown);
+  if (args.volume == "fade")
+    request.fade_region =
+        Eigen::AlignedBox3d(robot.min().array() - kFadeMargin, robot.max().array() + kFadeMargin);
 
-  // Default framing: the volume's height-map when there is one (also with --volume off, so that
-  // both views of fig. 3.4 share the camera), else the reach circle at q.
+  // Default framing: the robot with its ghosts and the obstacles near it; or (--frame volume) the
+  // volume's height-map when there is one (also with --volume off, so that both views of fig. 3.4
+  // share the camera), else the reach circle at q.
   const double fovy = scene.model().vis.global.fovy * 3.14159265358979323846 / 180;
   RenderCamera framed;
-  if (volume.grid.rows > 0) {
+  if (args.frame == "robot") {
+    framed = frame_box(robot_neighbourhood(scene, robot, kNearObstacles), RenderCamera{}, fovy,
+                       static_cast<double>(width) / height);
+  } else if (volume.grid.rows > 0) {
     const Grid& g = volume.grid;
     const Eigen::Vector2d centre(g.origin_x + 0.5 * g.rows * g.side, g.origin_y + 0.5 * g.cols * g.side);
     double top = kRobotHeight;

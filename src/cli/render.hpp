@@ -19,7 +19,8 @@ struct RenderArgs {
   std::string camera;               //!< "az,el,dist" [rad, rad, m]; empty: framing the reach circle
   std::string lookat;               //!< "x,y,z" [m]; empty: the reach circle's centre
   std::string size = "1280x960";    //!< image size [pixels]
-  std::string volume = "on";        //!< draw the volume: on or off
+  std::string volume = "fade";      //!< draw the volume: fade (around the robot), on or off
+  std::string frame = "robot";      //!< default camera: robot (and nearby obstacles) or volume
   std::string ghosts = "corners";   //!< ghosts: corners, joints or none
   std::string params;               //!< parameter file (with --from/--to)
   std::string preset = "leeway";    //!< parameter set (with --from/--to)

@@ -179,6 +179,58 @@ RenderCamera frame_circle(const Eigen::Vector2d& center, double radius, double h
   return c;
 }
 
+namespace {
+
+// The world-aligned box around an oriented box.
+Eigen::AlignedBox3d aligned(const Box& b) {
+  const Eigen::Vector3d reach = b.rotation.cwiseAbs() * b.half_size;
+  return Eigen::AlignedBox3d(b.center - reach, b.center + reach);
+}
+
+}  // namespace
+
+Eigen::AlignedBox3d robot_extent(const Scene& scene, const std::vector<Eigen::VectorXd>& qs) {
+  const mjModel& m = scene.model();
+  DataPtr d = make_data(m);
+  Eigen::AlignedBox3d out;
+  for (const Eigen::VectorXd& q : qs) {
+    scene.validate_configuration(q, "framed configuration");
+    scene.set_qpos(*d, q);
+    mj_kinematics(&m, d.get());
+    for (const auto* geoms : {&scene.link_geoms(), &scene.base_geoms()})
+      for (int g : *geoms)
+        if (m.geom_type[g] != mjGEOM_PLANE) out.extend(aligned(geom_box(m, *d, g)));
+  }
+  return out;
+}
+
+Eigen::AlignedBox3d robot_neighbourhood(const Scene& scene, const Eigen::AlignedBox3d& robot, double near) {
+  if (robot.isEmpty()) return robot;
+  const Eigen::AlignedBox3d around(robot.min().array() - near, robot.max().array() + near);
+  const mjModel& m = scene.model();
+  DataPtr d = make_data(m);
+  mj_kinematics(&m, d.get());  // obstacles do not move with the robot
+  Eigen::AlignedBox3d out = robot;
+  for (int g : scene.obstacle_geoms()) {
+    if (m.geom_type[g] == mjGEOM_PLANE) continue;
+    const Eigen::AlignedBox3d part = aligned(geom_box(m, *d, g)).intersection(around);
+    if (!part.isEmpty()) out.extend(part);
+  }
+  return out;
+}
+
+RenderCamera frame_box(const Eigen::AlignedBox3d& region, const RenderCamera& direction, double fovy,
+                       double aspect) {
+  RenderCamera c = direction;
+  if (region.isEmpty()) return c;
+  c.lookat = region.center();
+  // Half the diagonal, at least 10 cm: a point-sized region still gets a finite distance.
+  const double radius = std::max(0.1, 0.5 * region.diagonal().norm());
+  const double half_h = 0.5 * fovy, half_w = std::atan(aspect * std::tan(half_h));
+  c.distance = 1.05 * radius / std::sin(std::min(half_h, half_w));
+  return c;
+}
+
 std::array<float, 3> height_colour(double top, double max_top) {
   // Viridis at five stops, linearly interpolated.
   static constexpr float kStops[5][3] = {{0.267f, 0.005f, 0.329f},
@@ -334,6 +386,8 @@ Image render_scene(const Scene& scene, const RenderRequest& request) {
     scene.validate_configuration(request.ghosts[i], "ghost configuration " + std::to_string(i));
   if (!(request.volume_alpha >= 0 && request.volume_alpha <= 1))
     throw InputError("volume opacity " + format_number(request.volume_alpha) + " must be within [0, 1]");
+  if (!(request.faded_alpha >= 0 && request.faded_alpha <= 1))
+    throw InputError("faded volume opacity " + format_number(request.faded_alpha) + " must be within [0, 1]");
 
   install_mujoco_error_handlers();
   ModelPtr model(mj_copyModel(nullptr, &scene.model()));
@@ -383,7 +437,9 @@ Image render_scene(const Scene& scene, const RenderRequest& request) {
       for (int l = 0; l < 3; ++l) mat[3 * k + l] = b.rotation(k, l);
     }
     const auto c = height_colour(b.center.z() + b.half_size.z(), max_top);
-    const float rgba[4] = {c[0], c[1], c[2], static_cast<float>(request.volume_alpha)};
+    const bool faded = !request.fade_region.isEmpty() && request.fade_region.intersects(aligned(b));
+    const double alpha = faded ? request.faded_alpha : request.volume_alpha;
+    const float rgba[4] = {c[0], c[1], c[2], static_cast<float>(alpha)};
     mjvGeom& geom = scn.geoms[scn.ngeom++];
     // mjv_makeScene does not clear its geoms and mjv_initGeom leaves the sorter's fields
     // (camdist, modelrbound, transparent) as they were: start from zeros so that the picture does
@@ -391,7 +447,7 @@ Image render_scene(const Scene& scene, const RenderRequest& request) {
     geom = mjvGeom{};
     mjv_initGeom(&geom, mjGEOM_BOX, size, pos, mat, rgba);
     geom.category = mjCAT_DECOR;
-    if (request.volume_alpha < 1) mark_transparent(geom, campos);
+    if (alpha < 1) mark_transparent(geom, campos);
   }
 
   detail::OffscreenContext gl(m, request.width, request.height);

@@ -5,6 +5,7 @@
 //! ghosts of the robot at the extremes of its intervals; PNG encoding; the volume of a bounds file.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <array>
 #include <memory>
 #include <string>
@@ -52,6 +53,21 @@ struct RenderCamera {
 //! enough that its bounding sphere fits the vertical field of view `fovy` [rad].
 RenderCamera frame_circle(const Eigen::Vector2d& center, double radius, double height, double fovy);
 
+//! The world box [m] holding the robot's geoms (links and base; planes excluded) at every
+//! configuration of `qs`. @throws InputError on a configuration that does not fit the scene.
+Eigen::AlignedBox3d robot_extent(const Scene& scene, const std::vector<Eigen::VectorXd>& qs);
+
+//! What a robot picture frames: `robot` grown by `near` [m] on every side, shrunk to the robot and
+//! the parts of the obstacles inside that grown box (the nearby tables, walls and the patch, not the
+//! whole floor or a distant fence).
+Eigen::AlignedBox3d robot_neighbourhood(const Scene& scene, const Eigen::AlignedBox3d& robot, double near);
+
+//! A camera at `direction`'s azimuth and elevation looking at the centre of `region` [m] from far
+//! enough that the region's bounding sphere fits both the vertical field of view `fovy` [rad] and
+//! the horizontal one of an image `aspect` (width / height) wide.
+RenderCamera frame_box(const Eigen::AlignedBox3d& region, const RenderCamera& direction, double fovy,
+                       double aspect);
+
 //! Which ghosts to draw around the rendered configuration.
 enum class GhostMode {
   kNone,     //!< none
@@ -67,6 +83,10 @@ struct RenderRequest {
   std::vector<Box> volume;              //!< boxes drawn semi-transparent, coloured by their top's height
   std::vector<Eigen::VectorXd> ghosts;  //!< configurations drawn as translucent robots
   double volume_alpha = 0.45;           //!< opacity of the volume boxes
+  //! Volume boxes that meet this region [m] are drawn at `faded_alpha` (the volume faded around
+  //! the robot, so that the robot stays visible); empty: none.
+  Eigen::AlignedBox3d fade_region;
+  double faded_alpha = 0.08;
 };
 
 //! Colour of a volume box whose top is at `top` [m], on a blue-green-yellow scale (viridis-like)

@@ -237,8 +237,8 @@ TEST_F(RenderTest, TurningTheFramedArmChangesManyPixels) {
   EXPECT_GT(near, 3 * far) << near << " " << far;
 }
 
-// --volume fade: a box that meets the fade region is drawn at the faded opacity, one that does not
-// at the normal one.
+// --volume fade: a box that meets the fade region, or stands between it and the camera, is drawn at
+// the faded opacity; one that does neither at the normal one.
 TEST_F(RenderTest, VolumeBoxesAroundTheRobotAreFaded) {
   const Scene s = scene();
   RenderRequest r;
@@ -267,6 +267,21 @@ TEST_F(RenderTest, VolumeBoxesAroundTheRobotAreFaded) {
   EXPECT_GT(tint(normal), 40);
   EXPECT_LT(tint(faded), tint(normal) / 2) << tint(faded) << " " << tint(normal);
   EXPECT_GT(tint(faded), tint(none)) << tint(faded) << " " << tint(none);
+  // A box above the region (nearer to the camera, which looks down from above) hides it: faded
+  // too, though it does not meet the region.
+  Box above = box;
+  above.center.z() = 2.0;
+  r.volume = {above};
+  r.fade_region = Eigen::AlignedBox3d();
+  const Image above_normal = render_scene(s, r);
+  r.fade_region = Eigen::AlignedBox3d(Eigen::Vector3d(-2, 1, 0), Eigen::Vector3d(-1, 2, 1));
+  const Image above_faded = render_scene(s, r);
+  ASSERT_TRUE(project_point(r.camera, fovy, r.width, r.height, {-1.5, 1.5, 2.25}, px));
+  const int ax = static_cast<int>(px.x()), ay = static_cast<int>(px.y());
+  auto tint_at = [&](const Image& img) { return int{img.at(ax, ay)[0]} - int{img.at(ax, ay)[2]}; };
+  EXPECT_GT(tint_at(above_normal), 40);
+  EXPECT_LT(tint_at(above_faded), tint_at(above_normal) / 2)
+      << tint_at(above_faded) << " " << tint_at(above_normal);
   r.faded_alpha = 1.5;
   r.volume = {box};
   EXPECT_THROW(render_scene(s, r), InputError);

@@ -187,6 +187,47 @@ Eigen::AlignedBox3d aligned(const Box& b) {
   return Eigen::AlignedBox3d(b.center - reach, b.center + reach);
 }
 
+// Which volume boxes are faded: those that meet the fade region, and those that could hide part of
+// it (nearer to the camera than its far side, their picture overlapping its picture).
+class FadeTest {
+ public:
+  FadeTest(const RenderRequest& r, double fovy) : r_(r), fovy_(fovy) {
+    if (r.fade_region.isEmpty()) return;
+    Eigen::Vector3d up;
+    camera_frame(r.camera, pos_, forward_, up);
+    far_ = -INFINITY;
+    for (int k = 0; k < 8; ++k) {
+      const Eigen::Vector3d p = r.fade_region.corner(static_cast<Eigen::AlignedBox3d::CornerType>(k));
+      far_ = std::max(far_, forward_.dot(p - pos_));
+      Eigen::Vector2d px;
+      if (!project_point(r.camera, fovy, r.width, r.height, p, px)) px = Eigen::Vector2d::Zero();
+      picture_.extend(px);
+    }
+  }
+  bool operator()(const Box& b) const {
+    if (r_.fade_region.isEmpty()) return false;
+    const Eigen::AlignedBox3d box = aligned(b);
+    if (r_.fade_region.intersects(box)) return true;
+    Eigen::AlignedBox2d picture;
+    double near = INFINITY;
+    for (int k = 0; k < 8; ++k) {
+      const Eigen::Vector3d p = box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(k));
+      near = std::min(near, forward_.dot(p - pos_));
+      Eigen::Vector2d px;
+      if (!project_point(r_.camera, fovy_, r_.width, r_.height, p, px)) return true;  // around the camera
+      picture.extend(px);
+    }
+    return near < far_ && picture.intersects(picture_);
+  }
+
+ private:
+  const RenderRequest& r_;
+  double fovy_;
+  Eigen::Vector3d pos_ = Eigen::Vector3d::Zero(), forward_ = Eigen::Vector3d::UnitX();
+  double far_ = 0;
+  Eigen::AlignedBox2d picture_;
+};
+
 }  // namespace
 
 Eigen::AlignedBox3d robot_extent(const Scene& scene, const std::vector<Eigen::VectorXd>& qs) {
@@ -426,6 +467,7 @@ Image render_scene(const Scene& scene, const RenderRequest& request) {
   }
 
   // The volume: one box per volume box, coloured by the height of its top.
+  const FadeTest fade(request, m.vis.global.fovy * kPi / 180);
   double max_top = 0;
   for (const Box& b : request.volume) max_top = std::max(max_top, b.center.z() + b.half_size.z());
   for (const Box& b : request.volume) {
@@ -437,7 +479,7 @@ Image render_scene(const Scene& scene, const RenderRequest& request) {
       for (int l = 0; l < 3; ++l) mat[3 * k + l] = b.rotation(k, l);
     }
     const auto c = height_colour(b.center.z() + b.half_size.z(), max_top);
-    const bool faded = !request.fade_region.isEmpty() && request.fade_region.intersects(aligned(b));
+    const bool faded = fade(b);
     const double alpha = faded ? request.faded_alpha : request.volume_alpha;
     const float rgba[4] = {c[0], c[1], c[2], static_cast<float>(alpha)};
     mjvGeom& geom = scn.geoms[scn.ngeom++];

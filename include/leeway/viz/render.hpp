@@ -83,8 +83,9 @@ struct RenderRequest {
   std::vector<Box> volume;              //!< boxes drawn semi-transparent, coloured by their top's height
   std::vector<Eigen::VectorXd> ghosts;  //!< configurations drawn as translucent robots
   double volume_alpha = 0.45;           //!< opacity of the volume boxes
-  //! Volume boxes that meet this region [m] are drawn at `faded_alpha` (the volume faded around
-  //! the robot, so that the robot stays visible); empty: none.
+  //! Volume boxes that meet this region [m], or stand between it and the camera (nearer than its
+  //! far side, their picture overlapping its picture), are drawn at `faded_alpha`: the volume
+  //! faded around and in front of the robot, so that the robot stays visible. Empty: none.
   Eigen::AlignedBox3d fade_region;
   double faded_alpha = 0.08;
 };

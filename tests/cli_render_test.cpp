@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "leeway/core/error.hpp"
 #include "leeway/core/scene.hpp"
 #include "leeway/viz/export_mjcf.hpp"
 #include "leeway/viz/plot.hpp"
@@ -133,6 +134,56 @@ TEST_F(CliRenderTest, FromToComputesTheBoundsAndBareCellRenders) {
   EXPECT_EQ(png_size(path("bare.png")), (std::array<int, 2>{80, 60}));
 }
 
+// --strip K: K frames at evenly spaced nominal times side by side. The first is at t = 0, the
+// first waypoint's box value for value, and the last at the end, the last waypoint's: with the same
+// camera they are the pictures of --waypoint 0 and --waypoint 1, pixel for pixel.
+TEST_F(CliRenderTest, StripFramesAreThePathsWaypointsAtItsEnds) {
+  const std::string b = bounds_file();
+  const std::string cell = workcell("dallara");
+  const std::string camera = " --camera -2.4,-0.9,9 --lookat 0.5,-0.5,1.5";
+  const auto strip = run_cli("render " + cell + " --bounds " + b + " --strip 3 --size 240x80 --out " +
+                             path("strip.png") + camera);
+  ASSERT_EQ(strip.exit_code, 0) << strip.out;
+  EXPECT_THAT(strip.out, HasSubstr("3 frames along"));
+  EXPECT_EQ(png_size(path("strip.png")), (std::array<int, 2>{240, 80}));
+  const Image s = test::read_png(path("strip.png"));
+  for (int w : {0, 1}) {
+    const std::string out = path("w" + std::to_string(w) + ".png");
+    const auto one = run_cli("render " + cell + " --bounds " + b + " --waypoint " + std::to_string(w) +
+                             " --size 80x80 --out " + out + camera);
+    ASSERT_EQ(one.exit_code, 0) << one.out;
+    const Image single = test::read_png(out);
+    const int x0 = w == 0 ? 0 : 160;
+    int differ = 0;
+    for (int y = 0; y < 80; ++y)
+      for (int x = 0; x < 80; ++x) differ += s.at(x0 + x, y) != single.at(x, y) ? 1 : 0;
+    EXPECT_EQ(differ, 0) << "waypoint " << w;
+  }
+  // The middle frame is neither end: the arm is half way.
+  int middle = 0;
+  for (int y = 0; y < 80; ++y)
+    for (int x = 0; x < 80; ++x) middle += s.at(80 + x, y) != s.at(160 + x, y) ? 1 : 0;
+  EXPECT_GT(middle, 0);
+}
+
+TEST(TileTest, SideBySideRowByRow) {
+  Image a, b;
+  a.width = 1;
+  a.height = 2;
+  a.rgb = {1, 1, 1, 2, 2, 2};
+  b.width = 2;
+  b.height = 2;
+  b.rgb = {3, 3, 3, 4, 4, 4, 5, 5, 5, 6, 6, 6};
+  const Image t = tile_horizontally({a, b});
+  EXPECT_EQ(t.width, 3);
+  EXPECT_EQ(t.height, 2);
+  EXPECT_EQ(t.rgb, (std::vector<unsigned char>{1, 1, 1, 3, 3, 3, 4, 4, 4, 2, 2, 2, 5, 5, 5, 6, 6, 6}));
+  b.height = 1;
+  b.rgb.resize(6);
+  EXPECT_THROW(tile_horizontally({a, b}), InputError);
+  EXPECT_THROW(tile_horizontally({}), InputError);
+}
+
 // The same picture whatever the thread count and whether the bounds come from a file: the boxes
 // added to MuJoCo's scene once kept what the heap held in the sorter's fields, and the thesis
 // preset's translucent volume came out other with --threads 1 than with 2.
@@ -175,6 +226,11 @@ TEST_F(CliRenderTest, BadInputExitsTwoAndWritesNothing) {
       {cell + " --out " + out + " --lookat 0,0,inf", "--lookat"},
       {cell + " --out " + out + " --volume maybe", "--volume 'maybe' must be fade, on or off"},
       {cell + " --out " + out + " --frame nowhere", "--frame 'nowhere' must be robot or volume"},
+      {workcell("dallara") + " --out " + out + " --strip 3",
+       "--strip 3: there is no path without --bounds or --from/--to"},
+      {cell + " --out " + out + " --strip 1", "--strip 1 must be within 2 .. 64"},
+      {cell + " --out " + out + " --strip 3 --waypoint 0", "not with --waypoint 0"},
+      {cell + " --out " + out + " --strip 3 --size 40x40", "frames 13 pixels wide"},
       {cell + " --out " + out + " --ghosts all", "--ghosts 'all'"},
       {workcell("dallara") + " --from home --to nowhere --out " + out, "nowhere"},
       {workcell("dallara") + " --from home --to patch --waypoint 2 --out " + out,

@@ -2,7 +2,9 @@
 
 #include <cmath>
 #include <iostream>
+#include <optional>
 
+#include "leeway/core/bounds_trajectory.hpp"
 #include "leeway/core/file_io.hpp"
 #include "leeway/core/mjcf_source.hpp"
 #include "leeway/core/pipeline.hpp"
@@ -19,6 +21,8 @@ constexpr double kRobotHeight = 2.5;
 constexpr double kNearObstacles = 0.3;
 // --volume fade: volume boxes within this of the robot's box [m] are drawn nearly clear.
 constexpr double kFadeMargin = 0.05;
+// --strip: at most this many frames.
+constexpr int kMaxStrip = 64;
 
 // The robot's base on the floor at q: the first hinge joint's anchor (the reach circle's centre).
 Eigen::Vector2d arm_base(const Scene& scene, const Eigen::VectorXd& q) {
@@ -72,6 +76,9 @@ CLI::App* add_render(CLI::App& app, RenderArgs& args) {
                   "Default camera: robot (the robot, its ghosts and the obstacles near them) or volume\n"
                   "(the height-map's square up to its highest box, or the reach circle without a volume)")
       ->capture_default_str();
+  sub->add_option("--strip", args.strip,
+                  "K frames at evenly spaced nominal times along the path, side by side in one image\n"
+                  "(--size is the whole image; with --bounds or --from/--to)");
   sub->add_option("--ghosts", args.ghosts,
                   "Ghosts of the robot: corners (all joints at their lower, all at their upper bound),\n"
                   "joints (each joint at each bound) or none")
@@ -119,52 +126,26 @@ RenderCamera parse_camera(const std::string& text) {
 
 }  // namespace
 
-int run_render(const RenderArgs& args) {
-  // Every flag is checked before any work, so that bad input writes nothing.
-  std::vector<std::string> inputs = model_input_files(args.cell);
-  inputs.insert(inputs.end(), {args.bounds, args.params});
-  require_outputs({{args.out, "--out", {".png"}}}, inputs);
-  const auto [width, height] = parse_size(args.size, "--size");
-  if (args.volume != "fade" && args.volume != "on" && args.volume != "off")
-    throw InputError("--volume '" + args.volume + "' must be fade, on or off");
-  if (args.frame != "robot" && args.frame != "volume")
-    throw InputError("--frame '" + args.frame + "' must be robot or volume");
-  const GhostMode ghosts = parse_ghosts(args.ghosts);
-  const bool camera_given = !args.camera.empty();
-  RenderCamera camera = camera_given ? parse_camera(args.camera) : RenderCamera{};
-  Eigen::Vector3d lookat;
-  if (!args.lookat.empty()) {
-    const Eigen::VectorXd v = parse_vector(args.lookat, "--lookat");
-    if (v.size() != 3) throw InputError("--lookat '" + args.lookat + "' must be three numbers x,y,z [m]");
-    lookat = v;
-  }
-  const bool with_path = !args.from.empty() || !args.to.empty();
-  if (with_path && (args.from.empty() || args.to.empty()))
-    throw InputError("--from and --to go together (two keyframes)");
-  if (with_path && !args.key.empty())
-    throw InputError("--key shows a keyframe without bounds: not with --from/--to");
-  if (!with_path && args.bounds.empty() && args.waypoint != -1)
-    throw InputError("--waypoint " + std::to_string(args.waypoint) +
-                     ": there is no path without --bounds or --from/--to");
-  require_threads(args.threads);
+namespace {
 
-  const auto scene = Scene::load(args.cell, scene_options(kDefaultTool));
-  Params p = load_params(scene, args.preset, args.params, args.safety);
-  if (args.max_cells_given) p.height_map.max_cells = args.max_cells;
-  p.validate();
-  apply_joint_bounds_options(scene, args.joints, p);
-  const bool show_volume = args.volume != "off";
-
+// The bounds (from the file, or computed on the nominal path as leeway bounds does) and their
+// volume; nullopt when the path was refused (already reported).
+struct RenderInput {
   std::vector<WaypointBounds> bounds;
   Volume volume;
-  std::string what;
+  std::string what;  // the file, or the path's label
+};
+
+std::optional<RenderInput> render_input(const RenderArgs& args, const Scene& scene, Params& p,
+                                        bool show_volume) {
+  RenderInput in;
   if (!args.bounds.empty()) {
     BoundsFileVolume file = read_bounds_volume(args.bounds, scene, /*require_volume=*/show_volume);
-    bounds = std::move(file.bounds);
-    volume = std::move(file.volume);
+    in.bounds = std::move(file.bounds);
+    in.volume = std::move(file.volume);
     p = file.params;
-    what = args.bounds;
-  } else if (with_path) {
+    in.what = args.bounds;
+  } else if (!args.from.empty()) {
     if (args.waypoints < 2)
       throw InputError("--waypoints " + std::to_string(args.waypoints) + " must be >= 2");
     require_memory(args.waypoints * kBytesPerWaypoint, "--waypoints " + std::to_string(args.waypoints));
@@ -175,7 +156,7 @@ int run_render(const RenderArgs& args) {
     request.waypoints = args.waypoints;
     request.plan_around = !args.no_plan;
     const NominalPath path = resolve_nominal_path(scene, request);
-    if (!report_refusal(path)) return kExitFindings;
+    if (!report_refusal(path)) return std::nullopt;
     if (!path.replaced.empty()) std::cout << path.replaced << "\n";
     const int n = static_cast<int>(path.waypoints.size());
     if (args.waypoint >= n)
@@ -183,67 +164,163 @@ int run_render(const RenderArgs& args) {
                        " waypoints (0 .. " + std::to_string(n - 1) + ")");
     VolumeModel world(scene, VolumeModel::capacity_for(scene, p.height_map.max_cells));
     BoundsRun run = compute_bounds(scene, world, path.waypoints, p, args.threads);
-    bounds = std::move(run.bounds);
-    volume = std::move(run.volume);
-    what = path.label;
+    in.bounds = std::move(run.bounds);
+    in.volume = std::move(run.volume);
+    in.what = path.label;
   }
-  const int n = static_cast<int>(bounds.size());
-  if (!bounds.empty() && (args.waypoint < -1 || args.waypoint >= n))
-    throw InputError("--waypoint " + std::to_string(args.waypoint) + ": " + what + " has " +
-                     std::to_string(n) + " waypoints (0 .. " + std::to_string(n - 1) + ")");
-  const int k = args.waypoint == -1 ? n - 1 : args.waypoint;
+  return in;
+}
 
-  RenderRequest request;
-  request.width = width;
-  request.height = height;
+// One picture: the robot at q and its ghosts.
+struct Frame {
+  Eigen::VectorXd q;
+  std::vector<Eigen::VectorXd> ghosts;
+};
+
+// The frames shown: the bare cell's keyframe, waypoint k, or (--strip K) K boxes at evenly spaced
+// nominal times along the path (BoundsTrajectory: linear in the path parameter between waypoints).
+std::vector<Frame> render_frames(const RenderArgs& args, const Scene& scene,
+                                 const std::vector<WaypointBounds>& bounds, int k, GhostMode ghosts) {
   if (bounds.empty()) {
-    request.q = !args.key.empty()            ? scene.keyframe(args.key).q
-                : !scene.keyframes().empty() ? scene.keyframes().front().q
-                                             : Eigen::VectorXd::Zero(scene.dof());
-  } else {
-    request.q = bounds[static_cast<size_t>(k)].q;
-    request.ghosts = ghost_configurations(bounds[static_cast<size_t>(k)], ghosts);
+    const Eigen::VectorXd q = !args.key.empty()            ? scene.keyframe(args.key).q
+                              : !scene.keyframes().empty() ? scene.keyframes().front().q
+                                                           : Eigen::VectorXd::Zero(scene.dof());
+    return {Frame{q, {}}};
   }
-  if (show_volume) request.volume = volume.boxes;
-  std::vector<Eigen::VectorXd> shown = request.ghosts;
-  shown.push_back(request.q);
-  const Eigen::AlignedBox3d robot = robot_extent(scene, shown);
-  if (args.volume == "fade")
-    request.fade_region =
-        Eigen::AlignedBox3d(robot.min().array() - kFadeMargin, robot.max().array() + kFadeMargin);
+  if (args.strip == 0)
+    return {Frame{bounds[static_cast<size_t>(k)].q,
+                  ghost_configurations(bounds[static_cast<size_t>(k)], ghosts)}};
+  const BoundsTrajectory path(scene, bounds);
+  std::vector<Frame> out;
+  for (int j = 0; j < args.strip; ++j) {
+    const BoundsStage at = path.at_t(path.duration() * j / (args.strip - 1));
+    out.push_back(
+        Frame{at.nominal, ghost_configurations(WaypointBounds(at.nominal, at.lower, at.upper), ghosts)});
+  }
+  return out;
+}
 
-  // Default framing: the robot with its ghosts and the obstacles near it; or (--frame volume) the
-  // volume's height-map when there is one (also with --volume off, so that both views of fig. 3.4
-  // share the camera), else the reach circle at q.
+// The default camera: --frame robot fits every frame's robot and ghosts and the obstacles near them;
+// --frame volume the volume's height-map when there is one (also with --volume off, so that both
+// views of fig. 3.4 share the camera), else the reach circle at the first frame.
+RenderCamera default_camera(const RenderArgs& args, const Scene& scene, const Params& p, const Volume& volume,
+                            const Eigen::AlignedBox3d& robots, const Eigen::VectorXd& q, double aspect) {
   const double fovy = scene.model().vis.global.fovy * 3.14159265358979323846 / 180;
-  RenderCamera framed;
-  if (args.frame == "robot") {
-    framed = frame_box(robot_neighbourhood(scene, robot, kNearObstacles), RenderCamera{}, fovy,
-                       static_cast<double>(width) / height);
-  } else if (volume.grid.rows > 0) {
+  if (args.frame == "robot")
+    return frame_box(robot_neighbourhood(scene, robots, kNearObstacles), RenderCamera{}, fovy, aspect);
+  if (volume.grid.rows > 0) {
     const Grid& g = volume.grid;
     const Eigen::Vector2d centre(g.origin_x + 0.5 * g.rows * g.side, g.origin_y + 0.5 * g.cols * g.side);
     double top = kRobotHeight;
     for (const Box& b : volume.boxes) top = std::max(top, b.center.z() + b.half_size.z());
-    framed = frame_circle(centre, 0.5 * std::max(g.rows, g.cols) * g.side, top, fovy);
-  } else {
-    framed = frame_circle(arm_base(scene, request.q), p.volume.reach_radius, kRobotHeight, fovy);
+    return frame_circle(centre, 0.5 * std::max(g.rows, g.cols) * g.side, top, fovy);
   }
-  if (!camera_given) {
-    camera.distance = framed.distance;
-  }
-  camera.lookat = args.lookat.empty() ? framed.lookat : lookat;
-  request.camera = camera;
+  return frame_circle(arm_base(scene, q), p.volume.reach_radius, kRobotHeight, fovy);
+}
 
-  const Image image = render_scene(scene, request);
+// Checks every flag that needs no cell, before any work.
+void check_render_args(const RenderArgs& args) {
+  if (args.volume != "fade" && args.volume != "on" && args.volume != "off")
+    throw InputError("--volume '" + args.volume + "' must be fade, on or off");
+  if (args.frame != "robot" && args.frame != "volume")
+    throw InputError("--frame '" + args.frame + "' must be robot or volume");
+  const bool with_path = !args.from.empty() || !args.to.empty();
+  if (with_path && (args.from.empty() || args.to.empty()))
+    throw InputError("--from and --to go together (two keyframes)");
+  if (with_path && !args.key.empty())
+    throw InputError("--key shows a keyframe without bounds: not with --from/--to");
+  if (!with_path && args.bounds.empty() && args.waypoint != -1)
+    throw InputError("--waypoint " + std::to_string(args.waypoint) +
+                     ": there is no path without --bounds or --from/--to");
+  if (args.strip != 0 && (args.strip < 2 || args.strip > kMaxStrip))
+    throw InputError("--strip " + std::to_string(args.strip) + " must be within 2 .. " +
+                     std::to_string(kMaxStrip));
+  if (args.strip != 0 && !with_path && args.bounds.empty())
+    throw InputError("--strip " + std::to_string(args.strip) +
+                     ": there is no path without --bounds or --from/--to");
+  if (args.strip != 0 && args.waypoint != -1)
+    throw InputError("--strip shows the whole path: not with --waypoint " + std::to_string(args.waypoint));
+  require_threads(args.threads);
+}
+
+}  // namespace
+
+int run_render(const RenderArgs& args) {
+  // Every flag is checked before any work, so that bad input writes nothing.
+  std::vector<std::string> inputs = model_input_files(args.cell);
+  inputs.insert(inputs.end(), {args.bounds, args.params});
+  require_outputs({{args.out, "--out", {".png"}}}, inputs);
+  const auto [width, height] = parse_size(args.size, "--size");
+  const GhostMode ghosts = parse_ghosts(args.ghosts);
+  const bool camera_given = !args.camera.empty();
+  RenderCamera camera = camera_given ? parse_camera(args.camera) : RenderCamera{};
+  Eigen::Vector3d lookat;
+  if (!args.lookat.empty()) {
+    const Eigen::VectorXd v = parse_vector(args.lookat, "--lookat");
+    if (v.size() != 3) throw InputError("--lookat '" + args.lookat + "' must be three numbers x,y,z [m]");
+    lookat = v;
+  }
+  check_render_args(args);
+  const int frame_width = args.strip > 0 ? width / args.strip : width;
+  if (frame_width < 16)
+    throw InputError("--size " + args.size + " with --strip " + std::to_string(args.strip) +
+                     " leaves frames " + std::to_string(frame_width) + " pixels wide (at least 16)");
+
+  const auto scene = Scene::load(args.cell, scene_options(kDefaultTool));
+  Params p = load_params(scene, args.preset, args.params, args.safety);
+  if (args.max_cells_given) p.height_map.max_cells = args.max_cells;
+  p.validate();
+  apply_joint_bounds_options(scene, args.joints, p);
+  const bool show_volume = args.volume != "off";
+  const std::optional<RenderInput> in = render_input(args, scene, p, show_volume);
+  if (!in) return kExitFindings;
+  const int n = static_cast<int>(in->bounds.size());
+  if (n > 0 && (args.waypoint < -1 || args.waypoint >= n))
+    throw InputError("--waypoint " + std::to_string(args.waypoint) + ": " + in->what + " has " +
+                     std::to_string(n) + " waypoints (0 .. " + std::to_string(n - 1) + ")");
+  const int k = args.waypoint == -1 ? n - 1 : args.waypoint;
+  const std::vector<Frame> frames = render_frames(args, scene, in->bounds, k, ghosts);
+
+  Eigen::AlignedBox3d robots;
+  for (const Frame& f : frames) {
+    std::vector<Eigen::VectorXd> shown = f.ghosts;
+    shown.push_back(f.q);
+    robots.extend(robot_extent(scene, shown));
+  }
+  const RenderCamera framed = default_camera(args, scene, p, in->volume, robots, frames.front().q,
+                                             static_cast<double>(frame_width) / height);
+  if (!camera_given) camera.distance = framed.distance;
+  camera.lookat = args.lookat.empty() ? framed.lookat : lookat;
+
+  std::vector<Image> images;
+  for (const Frame& f : frames) {
+    RenderRequest request;
+    request.width = frame_width;
+    request.height = height;
+    request.camera = camera;
+    request.q = f.q;
+    request.ghosts = f.ghosts;
+    if (show_volume) request.volume = in->volume.boxes;
+    if (args.volume == "fade") {
+      std::vector<Eigen::VectorXd> shown = f.ghosts;
+      shown.push_back(f.q);
+      const Eigen::AlignedBox3d robot = robot_extent(scene, shown);
+      request.fade_region =
+          Eigen::AlignedBox3d(robot.min().array() - kFadeMargin, robot.max().array() + kFadeMargin);
+    }
+    images.push_back(render_scene(scene, request));
+  }
+  const Image image = images.size() == 1 ? images.front() : tile_horizontally(images);
   write_png(args.out, image);
-  std::cout << "wrote " << args.out << " (" << width << "x" << height << " pixels; "
-            << (bounds.empty() ? "no bounds" : "waypoint " + std::to_string(k) + " of " + what) << ", "
-            << request.volume.size() << " volume boxes, " << request.ghosts.size() << " ghosts; camera "
-            << format_number(camera.azimuth) << "," << format_number(camera.elevation) << ","
-            << format_number(camera.distance) << " [rad, rad, m], look-at "
-            << format_number(camera.lookat.x()) << "," << format_number(camera.lookat.y()) << ","
-            << format_number(camera.lookat.z()) << " [m])\n";
+  const std::string shown = n == 0           ? "no bounds"
+                            : args.strip > 0 ? std::to_string(args.strip) + " frames along " + in->what
+                                             : "waypoint " + std::to_string(k) + " of " + in->what;
+  std::cout << "wrote " << args.out << " (" << image.width << "x" << image.height << " pixels; " << shown
+            << ", " << (show_volume ? in->volume.boxes.size() : 0) << " volume boxes, "
+            << frames.front().ghosts.size() << " ghosts; camera " << format_number(camera.azimuth) << ","
+            << format_number(camera.elevation) << "," << format_number(camera.distance)
+            << " [rad, rad, m], look-at " << format_number(camera.lookat.x()) << ","
+            << format_number(camera.lookat.y()) << "," << format_number(camera.lookat.z()) << " [m])\n";
   return kExitOk;
 }
 

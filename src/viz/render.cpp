@@ -272,6 +272,29 @@ RenderCamera frame_box(const Eigen::AlignedBox3d& region, const RenderCamera& di
   return c;
 }
 
+Image tile_horizontally(const std::vector<Image>& images) {
+  if (images.empty()) throw InputError("no image to tile");
+  Image out;
+  out.height = images.front().height;
+  for (const Image& i : images) {
+    if (i.height != out.height)
+      throw InputError("images of heights " + std::to_string(out.height) + " and " +
+                       std::to_string(i.height) + " cannot be tiled side by side");
+    out.width += i.width;
+  }
+  out.rgb.resize(3 * static_cast<size_t>(out.width) * static_cast<size_t>(out.height));
+  for (int y = 0; y < out.height; ++y) {
+    size_t at = 3 * static_cast<size_t>(y) * static_cast<size_t>(out.width);
+    for (const Image& i : images) {
+      const size_t row = 3 * static_cast<size_t>(i.width);
+      std::copy_n(i.rgb.begin() + static_cast<std::ptrdiff_t>(row * static_cast<size_t>(y)), row,
+                  out.rgb.begin() + static_cast<std::ptrdiff_t>(at));
+      at += row;
+    }
+  }
+  return out;
+}
+
 std::array<float, 3> height_colour(double top, double max_top) {
   // Viridis at five stops, linearly interpolated.
   static constexpr float kStops[5][3] = {{0.267f, 0.005f, 0.329f},

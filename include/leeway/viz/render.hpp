@@ -68,6 +68,10 @@ Eigen::AlignedBox3d robot_neighbourhood(const Scene& scene, const Eigen::Aligned
 RenderCamera frame_box(const Eigen::AlignedBox3d& region, const RenderCamera& direction, double fovy,
                        double aspect);
 
+//! Images of one height side by side, left to right. @throws InputError on no image or heights
+//! that differ.
+Image tile_horizontally(const std::vector<Image>& images);
+
 //! Which ghosts to draw around the rendered configuration.
 enum class GhostMode {
   kNone,     //!< none

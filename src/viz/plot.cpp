@@ -1,6 +1,7 @@
 #include "leeway/viz/plot.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -304,6 +305,14 @@ Image bounds_image(const BoundsSeries& series, int width, int height, PlotX x) {
 
 namespace {
 
+// A whole field as a number, read with '.' as the decimal point whatever the locale (std::stod
+// follows the C locale's LC_NUMERIC); "nan" and "inf" read as such, for the finiteness check.
+bool parse_number(const std::string& text, double& v) {
+  const char* end = text.data() + text.size();
+  const auto r = std::from_chars(text.data() + (!text.empty() && text[0] == '+'), end, v);
+  return !text.empty() && r.ec == std::errc() && r.ptr == end;
+}
+
 // The fields of one CSV line as a spreadsheet writes them back: a field may be quoted ("a,b",
 // with "" for a quote inside), spaces around a field are dropped, a line may end in CR (CRLF).
 std::vector<std::string> csv_fields(std::string line, const std::string& where) {
@@ -365,13 +374,7 @@ SweepSeries read_sweep_csv(const std::string& path) {
       const std::string where =
           path + ": line " + std::to_string(number) + " column '" + header[col[k]] + "'";
       if (col[k] >= f.size()) throw InputError(where + " is missing");
-      try {
-        size_t used = 0;
-        v[k] = std::stod(f[col[k]], &used);
-        if (used != f[col[k]].size()) throw std::invalid_argument("trailing text");
-      } catch (const std::exception&) {
-        throw InputError(where + ": '" + f[col[k]] + "' is not a number");
-      }
+      if (!parse_number(f[col[k]], v[k])) throw InputError(where + ": '" + f[col[k]] + "' is not a number");
       if (!std::isfinite(v[k])) throw InputError(where + ": '" + f[col[k]] + "' is not a finite number");
     }
     if (v[0] < 1 || v[0] != std::floor(v[0]) || v[0] > kMaxCellsLimit)
@@ -396,7 +399,9 @@ std::vector<SweepPoint> thesis_table(const std::string& cell, const std::string&
     LEEWAY_DEMAND(f.size() == 7);
     if (f[1] != cell || f[2] != path) continue;
     if (table) *table = f[0];
-    out.push_back({std::stoi(f[3]), std::stod(f[4]), std::stod(f[5]), std::stod(f[6])});
+    double v[4] = {};
+    for (size_t k = 0; k < 4; ++k) LEEWAY_DEMAND(parse_number(f[3 + k], v[k]));
+    out.push_back({static_cast<int>(v[0]), v[1], v[2], v[3]});
   }
   return out;
 }

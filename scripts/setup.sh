@@ -2,7 +2,7 @@
 # Installs, from Debian's packages, whatever leeway needs to build and test that is not there yet.
 # Idempotent and non-interactive; when everything is installed it only asks dpkg and returns.
 # libqhull-dev: Debian's mujoco::mujoco target names /usr/include/libqhull_r as an include path.
-# libosmesa6-dev: offscreen OpenGL without a display for `leeway render` and PNG plots (MuJoCo links
+# libosmesa6-dev: offscreen OpenGL without a display for `leeway render` (PNG plots need none; MuJoCo links
 # no GL itself); zlib1g-dev: PNG compression. libopenmpi-dev, openmpi-bin: `leeway batch` and
 # leeway-tune over MPI ranks (optional for the build; the MPI tests run when mpirun is there).
 # pybind11-dev, python3-dev, python3-numpy, python3-pytest: the Python module (python/) and its tests,

@@ -233,11 +233,16 @@ TEST_F(CliRenderTest, PlotBadInput) {
       "short.json", R"({"joints": ["a", "b"], "waypoints": [{"q": [0], "lower": [0], "upper": [1]}]})");
   const std::string nan_file =
       dir_.write("nan.json", R"({"joints": ["a"], "waypoints": [{"q": [NaN], "lower": [0], "upper": [1]}]})");
+  const std::string back_in_time = dir_.write("back.json", R"({"joints": ["a"], "waypoints": [
+      {"t": 0, "q": [0], "lower": [0], "upper": [1]}, {"t": 0.5, "q": [0], "lower": [0], "upper": [1]},
+      {"t": 0.2, "q": [0], "lower": [0], "upper": [1]}]})");
   struct Case {
     std::string args, message;
   };
   const std::vector<Case> cases = {
       {b + " --out " + path("p.txt"), "must end in .svg or .png"},
+      {back_in_time + " --out " + path("p.svg"),
+       "back.json: waypoint 2 't' 0.2 s: times are finite, from 0 and never decrease"},
       {b + " --out /nonexistent-folder/p.svg", "cannot write there"},
       {b + " --out " + path("p.svg") + " --size 0x100", "--size '0x100'"},
       {bad + " --out " + path("p.svg"), "nominal 0 is not within [0.5, 1]"},

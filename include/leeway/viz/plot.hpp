@@ -36,7 +36,8 @@ struct BoundsSeries {
 
 //! Reads the series of a bounds file (format leeway-bounds-1, or older files without guide bounds).
 //! @throws InputError naming the file, waypoint and joint on a malformed file, sizes that differ,
-//! non-finite values or lower > nominal > upper.
+//! non-finite values, lower > nominal > upper, or times `t` that are not finite, start below 0 or
+//! decrease.
 BoundsSeries read_bounds_series(const std::string& path);
 
 //! The bounds plot's x axis: time t [s] (when the file has times, else s) or the path parameter s.

@@ -235,6 +235,22 @@ TEST(PlotTest, SizesTooSmallForThePanelsAreRefused) {
   EXPECT_EQ(test::error_of([&] { bounds_svg(s, 1400, 500); }),
             "plot size 1400x500 is too small for 6 joint panels in 3 row(s) of 2: at least 400x538 pixels");
   EXPECT_NO_THROW(bounds_svg(s, 400, 538));
+  // At the minimum size the y labels of a panel (right-aligned ticks) stand at least 20 pixels
+  // apart: a step of at least a quarter of the range on a plot area 100 pixels high, the 8-pixel
+  // font never overlapping.
+  const auto d = detail::bounds_drawing(s, 400, 538, PlotX::kTime);
+  double last = -1e9;
+  int labels = 0;
+  for (const auto& it : d.items) {
+    if (it.kind == detail::Item::kGroupBegin) last = -1e9;
+    if (it.kind != detail::Item::kText || it.cls != "tick" || it.anchor != 2) continue;
+    if (last > -1e9) {
+      EXPECT_GE(std::abs(it.y - last), 20) << it.text;
+    }
+    last = it.y;
+    ++labels;
+  }
+  EXPECT_GE(labels, 12);  // at least two per panel
   EXPECT_THROW(bounds_image(s, 399, 538), InputError);
   EXPECT_THROW(sweep_svg({{"leeway", {{100, 40, 1, 99}}}}, "t", 599, 400), InputError);
 }

@@ -2,11 +2,13 @@
 # Installs, from Debian's packages, whatever leeway needs to build and test that is not there yet.
 # Idempotent and non-interactive; when everything is installed it only asks dpkg and returns.
 # libqhull-dev: Debian's mujoco::mujoco target names /usr/include/libqhull_r as an include path.
-# libosmesa6-dev: offscreen OpenGL without a display for `leeway render` and PNG plots (MuJoCo links
+# libosmesa6-dev: offscreen OpenGL without a display for `leeway render` (PNG plots need none; MuJoCo links
 # no GL itself); zlib1g-dev: PNG compression. libopenmpi-dev, openmpi-bin: `leeway batch` and
 # leeway-tune over MPI ranks (optional for the build; the MPI tests run when mpirun is there).
 # pybind11-dev, python3-dev, python3-numpy, python3-pytest: the Python module (python/) and its tests,
 # built against and run with Debian's /usr/bin/python3 (optional: without pybind11 it is skipped).
+# locales: the locale sources from which the plot test compiles a decimal-comma locale (de_DE)
+# with localedef when none is installed.
 # ffmpeg: `leeway simulate --video` pipes its frames to it (optional: without it no video is written).
 # `--sanitizers` adds what scripts/sanitize.sh needs: clang and its sanitizer/libFuzzer runtimes
 # (gcc's ASan/UBSan/TSan runtimes come with build-essential).
@@ -17,7 +19,7 @@ packages=(
   libmujoco-dev libqhull-dev libeigen3-dev libompl-dev libnlopt-cxx-dev liburdfdom-dev
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
   libosmesa6-dev zlib1g-dev libopenmpi-dev openmpi-bin
-  pybind11-dev python3-dev python3-numpy python3-pytest ffmpeg
+  pybind11-dev python3-dev python3-numpy python3-pytest ffmpeg locales
 )
 for arg in "$@"; do
   case "$arg" in

@@ -258,9 +258,9 @@ TEST_F(CliRenderTest, PlotSvgParsesWithOneCurveSetPerJointAndPngHasItsSize) {
   const auto png = run_cli("plot " + b + " --out " + path("p.png"));
   ASSERT_EQ(png.exit_code, 0) << png.out;
   EXPECT_EQ(png_size(path("p.png")), (std::array<int, 2>{1000, 60 + 3 * 240}));
-  const auto sized = run_cli("plot " + b + " --out " + path("q.png") + " --size 640x480");
+  const auto sized = run_cli("plot " + b + " --out " + path("q.png") + " --size 640x560");
   ASSERT_EQ(sized.exit_code, 0) << sized.out;
-  EXPECT_EQ(png_size(path("q.png")), (std::array<int, 2>{640, 480}));
+  EXPECT_EQ(png_size(path("q.png")), (std::array<int, 2>{640, 560}));
 }
 
 TEST_F(CliRenderTest, PlotMarksShrunkAndCollapsedIntervals) {
@@ -290,23 +290,61 @@ TEST_F(CliRenderTest, PlotBadInput) {
       "short.json", R"({"joints": ["a", "b"], "waypoints": [{"q": [0], "lower": [0], "upper": [1]}]})");
   const std::string nan_file =
       dir_.write("nan.json", R"({"joints": ["a"], "waypoints": [{"q": [NaN], "lower": [0], "upper": [1]}]})");
+  const std::string back_in_time = dir_.write("back.json", R"({"joints": ["a"], "waypoints": [
+      {"t": 0, "q": [0], "lower": [0], "upper": [1]}, {"t": 0.5, "q": [0], "lower": [0], "upper": [1]},
+      {"t": 0.2, "q": [0], "lower": [0], "upper": [1]}]})");
   struct Case {
     std::string args, message;
   };
   const std::vector<Case> cases = {
       {b + " --out " + path("p.txt"), "must end in .svg or .png"},
+      {back_in_time + " --out " + path("p.svg"),
+       "back.json: waypoint 2 't' 0.2 s: times are finite, from 0 and never decrease"},
       {b + " --out /nonexistent-folder/p.svg", "cannot write there"},
       {b + " --out " + path("p.svg") + " --size 0x100", "--size '0x100'"},
       {bad + " --out " + path("p.svg"), "nominal 0 is not within [0.5, 1]"},
       {short_file + " --out " + path("p.svg"), "waypoint 0 'q' has 1 values, 'joints' names 2"},
       {nan_file + " --out " + path("p.svg"), "malformed JSON"},
+      // Six panels in three rows need 58 + 3 * 160 pixels.
+      {b + " --out " + path("p.svg") + " --size 1400x500",
+       "plot size 1400x500 is too small for 6 joint panels in 3 row(s) of 2: at least 400x538 pixels"},
+      {b + " --out " + path("p.png") + " --size 1400x500", "plot size 1400x500 is too small"},
+      {b + " --out " + path("p.svg") + " --x u", "--x: u not in {t,s}"},
   };
   for (const auto& c : cases) {
     const auto r = run_cli("plot " + c.args);
     EXPECT_EQ(r.exit_code, 2) << c.args << "\n" << r.out;
     EXPECT_THAT(r.out, HasSubstr(c.message)) << c.args;
     EXPECT_FALSE(fs::exists(path("p.svg")));
+    EXPECT_FALSE(fs::exists(path("p.png")));
   }
+}
+
+// A via point 0.036 s into a 0.55 s path is drawn at 0.036 / 0.55 of the axis (x = t by default),
+// at the middle with --x s; a file without times falls back to s with a note.
+TEST_F(CliRenderTest, PlotXAxisIsTimeBySecondsOrThePathParameter) {
+  const std::string b = dir_.write("t.json", R"({"joints": ["a"], "waypoints": [
+      {"t": 0, "q": [0], "lower": [-1], "upper": [1]},
+      {"t": 0.036, "q": [0], "lower": [-1], "upper": [1]},
+      {"t": 0.55, "q": [0], "lower": [-1], "upper": [1]}]})");
+  // One panel of 400x300: plot area from x 64, 316 wide; y = 1 at row 82 + 182 * 0.1 / 2.2 = 90.27.
+  auto r = run_cli("plot " + b + " --out " + path("t.svg") + " --size 400x300");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  std::string svg = test::run_program("cat", path("t.svg")).out;
+  EXPECT_THAT(svg,
+              HasSubstr("class=\"upper\" fill=\"none\" points=\"64.00,90.27 84.68,90.27 380.00,90.27\""));
+  EXPECT_THAT(svg, HasSubstr(">time t [s]; lines join the waypoints</text>"));
+  r = run_cli("plot " + b + " --out " + path("s.svg") + " --size 400x300 --x s");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  svg = test::run_program("cat", path("s.svg")).out;
+  EXPECT_THAT(svg,
+              HasSubstr("class=\"upper\" fill=\"none\" points=\"64.00,90.27 222.00,90.27 380.00,90.27\""));
+  const std::string old = dir_.write("old.json", R"({"joints": ["a"], "waypoints": [
+      {"q": [0], "lower": [-1], "upper": [1]}, {"q": [0], "lower": [-1], "upper": [1]}]})");
+  r = run_cli("plot " + old + " --out " + path("o.svg") + " --size 400x300");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_THAT(r.out,
+              HasSubstr("has no waypoint times 't' (or lasts 0 s): the x axis is the path parameter s"));
 }
 
 TEST_F(CliRenderTest, SweepPlotHasTheThesisSeriesForOneOfTheNineCases) {

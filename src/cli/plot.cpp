@@ -25,6 +25,11 @@ CLI::App* add_plot(CLI::App& app, PlotArgs& args) {
   sub->add_option("--size", args.size,
                   "Image size WIDTHxHEIGHT [pixels] (default: bounds 1000 wide and 240 per row of panels;\n"
                   "sweeps 1200x420)");
+  sub->add_option("--x", args.x,
+                  "Bounds plots' x axis: t, the waypoints' time [s] (a file without times falls back to s,\n"
+                  "with a note), or s, the path parameter k / (n - 1)")
+      ->check(CLI::IsMember({"t", "s"}))
+      ->capture_default_str();
   sub->add_option("--thesis", args.thesis,
                   "Sweep plots: add the thesis's published table of CELL/PATH (dallara, baltico or dlr;\n"
                   "home-patch, patch-mould or mould-home)");
@@ -79,15 +84,19 @@ int run_plot(const PlotArgs& args) {
   if (!args.thesis.empty()) throw InputError("--thesis adds a thesis table to sweep plots (CSV files) only");
   if (width == 0) width = 1000;
   const BoundsSeries series = read_bounds_series(args.inputs.front());
+  const PlotX x = args.x == "s" ? PlotX::kPathParameter : PlotX::kTime;
+  if (x == PlotX::kTime && !series.has_times())
+    std::cerr << "note: " << args.inputs.front()
+              << " has no waypoint times 't' (or lasts 0 s): the x axis is the path parameter s\n";
   if (height == 0) {
     const size_t cols = series.joints.size() > 3 ? 2 : 1;
     height = 60 + 240 * static_cast<int>((series.joints.size() + cols - 1) / cols);
     height = std::min(height, 8192);
   }
   if (std::filesystem::path(args.out).extension() == ".svg")
-    write_file_atomic(args.out, bounds_svg(series, width, height));
+    write_file_atomic(args.out, bounds_svg(series, width, height, x));
   else
-    write_png(args.out, bounds_image(series, width, height));
+    write_png(args.out, bounds_image(series, width, height, x));
   std::cout << "wrote " << args.out << " (" << series.joints.size() << " joints, " << series.q.size()
             << " waypoints; units: rad, m)\n";
   return kExitOk;

@@ -16,6 +16,7 @@ struct PlotArgs {
   std::string out;                  //!< .svg or .png file to write
   std::string size;                 //!< "WIDTHxHEIGHT" [pixels]; empty: a size for the kind of plot
   std::string thesis;               //!< sweep plots: "CELL/PATH" of the thesis table to add
+  std::string x = "t";              //!< bounds plots' x axis: "t" (time [s]) or "s" (path parameter)
 };
 
 //! Adds the `plot` subcommand, parsing into `args`; returns it.

@@ -1,15 +1,15 @@
 #include "leeway/viz/plot.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <memory>
 #include <sstream>
 #include <stdexcept>
 
+#include "canvas.hpp"
 #include "core/json_io.hpp"
 #include "io/mjcf_text.hpp"
 #include "leeway/core/error.hpp"
@@ -24,44 +24,13 @@ extern const char* const kThesisTablesCsv;  // docs/data/thesis_tables.csv, embe
 
 namespace {
 
+using detail::Drawing;
+using detail::Points;
+using detail::Rgb;
+using detail::Ticks;
+
 // ---------------------------------------------------------------------------------------------
-// Shared: axis ticks, numbers, colours.
-
-std::string fixed(double v, int digits = 2) {
-  char buf[48];
-  std::snprintf(buf, sizeof(buf), "%.*f", digits, v);
-  return buf;
-}
-
-// A tick label: up to 4 significant digits, no trailing zeros.
-std::string tick_label(double v) {
-  if (std::abs(v) < 1e-12) return "0";
-  char buf[48];
-  if (std::abs(v) >= 1e4 && std::abs(v) < 1e9 && v == std::round(v)) {  // 10000, not 1e+04
-    std::snprintf(buf, sizeof(buf), "%.0f", v);
-    return buf;
-  }
-  std::snprintf(buf, sizeof(buf), "%.4g", v);
-  return buf;
-}
-
-std::string escape(const std::string& s) { return detail::xml_escape(s); }
-
-// About `n` ticks at 1, 2 or 5 times a power of ten within [lo, hi].
-std::vector<double> nice_ticks(double lo, double hi, int n) {
-  const double raw = (hi - lo) / std::max(1, n);
-  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
-  double step = mag;
-  for (double f : {1.0, 2.0, 5.0, 10.0})
-    if (f * mag >= raw) {
-      step = f * mag;
-      break;
-    }
-  std::vector<double> out;
-  for (double t = std::ceil(lo / step - 1e-9) * step; t <= hi + 1e-9 * step; t += step)
-    out.push_back(std::abs(t) < 1e-12 * step ? 0.0 : t);
-  return out;
-}
+// Shared: axes, colours, sizes.
 
 // The y range of a panel: the data's, padded by 5 % (or +-0.1 when flat).
 std::pair<double, double> padded(double lo, double hi) {
@@ -70,53 +39,16 @@ std::pair<double, double> padded(double lo, double hi) {
   return {lo - pad, hi + pad};
 }
 
-struct Rgb {
-  float r, g, b;
-  std::string hex() const {
-    char buf[8];
-    std::snprintf(buf, sizeof(buf), "#%02x%02x%02x", static_cast<int>(std::lround(255 * r)),
-                  static_cast<int>(std::lround(255 * g)), static_cast<int>(std::lround(255 * b)));
-    return buf;
-  }
-};
-constexpr Rgb kLower{0.13f, 0.44f, 0.71f}, kUpper{0.80f, 0.09f, 0.11f}, kNominal{0.1f, 0.1f, 0.1f};
-constexpr Rgb kGuide{0.55f, 0.55f, 0.55f}, kCollapsed{1.0f, 0.5f, 0.0f}, kBand{0.62f, 0.79f, 0.88f};
-constexpr Rgb kSeries[] = {
-    {0.13f, 0.44f, 0.71f}, {0.90f, 0.45f, 0.05f}, {0.2f, 0.6f, 0.2f}, {0.5f, 0.3f, 0.6f}};
+constexpr Rgb kLower{0.13, 0.44, 0.71}, kUpper{0.80, 0.09, 0.11}, kNominal{0.1, 0.1, 0.1};
+constexpr Rgb kGuide{0.55, 0.55, 0.55}, kCollapsed{1.0, 0.5, 0.0}, kBand{0.62, 0.79, 0.88};
+constexpr Rgb kPane{0.98, 0.98, 0.98}, kFrame{0.267, 0.267, 0.267}, kGrid{0.867, 0.867, 0.867};
+constexpr Rgb kSeries[] = {{0.13, 0.44, 0.71}, {0.90, 0.45, 0.05}, {0.2, 0.6, 0.2}, {0.5, 0.3, 0.6}};
+const std::vector<double> kGuideDash = {5, 3}, kSeriesDash = {6, 3};
+constexpr double kBandOpacity = 0.5;
+constexpr double kTop = 58;  // the title and legend band [px]
 
-// A minimal SVG writer: every coordinate in pixels with two decimals (deterministic text).
-class Svg {
- public:
-  Svg(int width, int height) {
-    o_ << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" width=\""
-       << width << "\" height=\"" << height << "\" viewBox=\"0 0 " << width << " " << height
-       << "\" font-family=\"DejaVu Sans, Arial, sans-serif\" font-size=\"12\">\n"
-       << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  }
-  void raw(const std::string& s) { o_ << s; }
-  void text(double x, double y, const std::string& s, const char* anchor = "start", int size = 12,
-            const char* extra = "") {
-    o_ << "<text x=\"" << fixed(x) << "\" y=\"" << fixed(y) << "\" text-anchor=\"" << anchor
-       << "\" font-size=\"" << size << "\"" << extra << ">" << escape(s) << "</text>\n";
-  }
-  void line(double x1, double y1, double x2, double y2, const std::string& stroke, double width = 1,
-            const char* extra = "") {
-    o_ << "<line x1=\"" << fixed(x1) << "\" y1=\"" << fixed(y1) << "\" x2=\"" << fixed(x2) << "\" y2=\""
-       << fixed(y2) << "\" stroke=\"" << stroke << "\" stroke-width=\"" << width << "\"" << extra << "/>\n";
-  }
-  void polyline(const std::vector<std::pair<double, double>>& pts, const std::string& cls, const Rgb& c,
-                double width, const char* extra = "") {
-    o_ << "<polyline class=\"" << cls << "\" fill=\"none\" stroke=\"" << c.hex() << "\" stroke-width=\""
-       << width << "\"" << extra << " points=\"";
-    for (size_t i = 0; i < pts.size(); ++i)
-      o_ << (i ? " " : "") << fixed(pts[i].first) << "," << fixed(pts[i].second);
-    o_ << "\"/>\n";
-  }
-  std::string str() { return o_.str() + "</svg>\n"; }
-
- private:
-  std::ostringstream o_;
-};
+// The smallest panel that still has room for its title, five tick labels and the x axis label.
+constexpr int kMinPanelWidth = 200, kMinPanelHeight = 160;
 
 // A rectangle of the image: the plot area of one panel.
 struct Area {
@@ -125,86 +57,34 @@ struct Area {
 
 // Axes, grid and tick labels of a panel; x and y map data to pixels.
 template <class X, class Y>
-void axes(Svg& svg, const Area& a, const std::vector<double>& xt, const std::vector<std::string>& xl,
-          const std::vector<double>& yt, const std::vector<std::string>& yl, X&& x, Y&& y) {
-  svg.raw("<rect x=\"" + fixed(a.x) + "\" y=\"" + fixed(a.y) + "\" width=\"" + fixed(a.w) + "\" height=\"" +
-          fixed(a.h) + "\" fill=\"#fafafa\" stroke=\"#444\" stroke-width=\"1\"/>\n");
-  for (size_t i = 0; i < xt.size(); ++i) {
-    svg.line(x(xt[i]), a.y, x(xt[i]), a.y + a.h, "#ddd");
-    svg.text(x(xt[i]), a.y + a.h + 14, xl[i], "middle", 10);
+void axes(Drawing& d, const Area& a, const Ticks& xt, const Ticks& yt, X&& x, Y&& y) {
+  d.rect(a.x, a.y, a.w, a.h, kPane, kFrame, 1);
+  for (size_t i = 0; i < xt.values.size(); ++i) {
+    d.polyline({{x(xt.values[i]), a.y}, {x(xt.values[i]), a.y + a.h}}, kGrid, 1);
+    d.label(x(xt.values[i]), a.y + a.h + 14, xt.labels[i], 10, 1, false, "tick");
   }
-  for (size_t i = 0; i < yt.size(); ++i) {
-    svg.line(a.x, y(yt[i]), a.x + a.w, y(yt[i]), "#ddd");
-    svg.text(a.x - 4, y(yt[i]) + 3.5, yl[i], "end", 10);
+  for (size_t i = 0; i < yt.values.size(); ++i) {
+    d.polyline({{a.x, y(yt.values[i])}, {a.x + a.w, y(yt.values[i])}}, kGrid, 1);
+    d.label(a.x - 4, y(yt.values[i]) + 3.5, yt.labels[i], 10, 2, false, "tick");
   }
 }
 
-std::vector<std::string> labels(const std::vector<double>& v) {
-  std::vector<std::string> out;
-  for (double t : v) out.push_back(tick_label(t));
-  return out;
+// A legend entry: a line sample (dashed when `dash` is set) and its text; returns the next x.
+double legend_line(Drawing& d, double x, const std::string& text, const Rgb& c,
+                   const std::vector<double>& dash) {
+  d.polyline({{x, 40}, {x + 24, 40}}, c, 2, dash);
+  d.label(x + 30, 44, text, 12);
+  return x + 40 + 7.0 * static_cast<double>(text.size());
 }
 
-// ---------------------------------------------------------------------------------------------
-// MuJoCo figures (PNG output).
-
-// An empty model: mjr_makeContext needs one for its offscreen buffer size and fonts.
-ModelPtr empty_model() { return load_model_text("<mujoco model=\"leeway_plot\"/>", "leeway_plot.xml"); }
-
-std::unique_ptr<mjvFigure> new_figure(const std::string& title, const std::string& xlabel) {
-  auto fig = std::make_unique<mjvFigure>();
-  mjv_defaultFigure(fig.get());
-  fig->flg_legend = 0;  // one legend for all panels, in the image's title band
-  fig->flg_extend = 0;
-  fig->linewidth = 2;
-  fig->gridsize[0] = 5;
-  fig->gridsize[1] = 5;
-  const float white[4] = {1, 1, 1, 1}, pane[4] = {0.98f, 0.98f, 0.98f, 1}, legend[4] = {1, 1, 1, 0.8f};
-  std::memcpy(fig->figurergba, white, sizeof(white));
-  std::memcpy(fig->panergba, pane, sizeof(pane));
-  std::memcpy(fig->legendrgba, legend, sizeof(legend));
-  const float text[3] = {0.1f, 0.1f, 0.1f}, grid[3] = {0.75f, 0.75f, 0.75f};
-  std::memcpy(fig->textrgb, text, sizeof(text));
-  std::memcpy(fig->gridrgb, grid, sizeof(grid));
-  std::snprintf(fig->title, sizeof(fig->title), "%s", title.c_str());
-  std::snprintf(fig->xlabel, sizeof(fig->xlabel), "%s", xlabel.c_str());
-  std::snprintf(fig->yformat, sizeof(fig->yformat), "%%.3g");
-  std::snprintf(fig->xformat, sizeof(fig->xformat), "%%.2g");
-  return fig;
-}
-
-// Adds a line (at most mjMAXLINEPNT points: longer series are thinned evenly); returns its index.
-int add_line(mjvFigure& fig, int& n, const std::string& name, const Rgb& c,
-             const std::vector<std::pair<double, double>>& pts) {
-  if (n >= mjMAXLINE || pts.empty()) return -1;
-  const size_t stride = (pts.size() + mjMAXLINEPNT - 1) / mjMAXLINEPNT;
-  int k = 0;
-  for (size_t i = 0; i < pts.size(); i += stride, ++k) {
-    fig.linedata[n][2 * k] = static_cast<float>(pts[i].first);
-    fig.linedata[n][2 * k + 1] = static_cast<float>(pts[i].second);
-  }
-  fig.linepnt[n] = k;
-  fig.linergb[n][0] = c.r;
-  fig.linergb[n][1] = c.g;
-  fig.linergb[n][2] = c.b;
-  std::snprintf(fig.linename[n], sizeof(fig.linename[n]), "%s", name.c_str());
-  return n++;
-}
-
-// Two lines of text at the top of the image: a title and a legend.
-void title_band(detail::OffscreenContext& gl, const std::string& title, const std::string& legend) {
-  const mjrRect v = gl.viewport();
-  mjr_label({0, v.height - 32, v.width, 32}, mjFONT_NORMAL, title.c_str(), 1, 1, 1, 1, 0.1f, 0.1f, 0.1f,
-            &gl.mjr());
-  mjr_label({0, v.height - 64, v.width, 32}, mjFONT_NORMAL, legend.c_str(), 1, 1, 1, 1, 0.3f, 0.3f, 0.3f,
-            &gl.mjr());
-}
-
-// Panels in a grid of `cols` columns filling the image below a `top` band.
-mjrRect cell_rect(int i, int cols, int rows, int width, int height, int top) {
-  const int w = width / cols, h = (height - top) / rows;
-  const int r = i / cols, c = i % cols;
-  return {c * w, height - top - (r + 1) * h, w, h};  // OpenGL rows count from the bottom
+// Refuses an image too small for its panels (they would be drawn with no room for their axes).
+void check_panels(int width, int height, int cols, int rows, const std::string& what) {
+  const int min_w = cols * kMinPanelWidth, min_h = static_cast<int>(kTop) + rows * kMinPanelHeight;
+  if (width < min_w || height < min_h)
+    throw InputError("plot size " + std::to_string(width) + "x" + std::to_string(height) +
+                     " is too small for " + what + " in " + std::to_string(rows) + " row(s) of " +
+                     std::to_string(cols) + ": at least " + std::to_string(min_w) + "x" +
+                     std::to_string(min_h) + " pixels");
 }
 
 }  // namespace
@@ -269,7 +149,14 @@ BoundsSeries read_bounds_series(const std::string& path) {
           collapsed[static_cast<size_t>(it - out.joints.begin())] = true;
         }
       out.collapsed.push_back(collapsed);
+      if (wps[w].contains("t") && out.t.size() == w) {
+        const double t = wps[w].at("t").get<double>();
+        if (!std::isfinite(t) || t < 0 || (w > 0 && t < out.t.back()))
+          fail(where + " 't' " + format_number(t) + " s: times are finite, from 0 and never decrease");
+        out.t.push_back(t);
+      }
     }
+    if (out.t.size() != wps.size()) out.t.clear();  // times on some waypoints only: none
   } catch (const nlohmann::json::exception& e) {
     throw InputError(path + ": unexpected content: " + e.what());
   }
@@ -279,152 +166,152 @@ BoundsSeries read_bounds_series(const std::string& path) {
   return out;
 }
 
-std::string bounds_svg(const BoundsSeries& series, int width, int height) {
-  detail::check_image_size(width, height, "plot size");
-  const size_t dof = series.joints.size(), n = series.q.size();
-  const int cols = dof > 3 ? 2 : 1;
-  const int rows = static_cast<int>((dof + static_cast<size_t>(cols) - 1) / static_cast<size_t>(cols));
-  const double top = 58;
-  const double pw = static_cast<double>(width) / cols, ph = (height - top) / rows;
-  Svg svg(width, height);
-  svg.text(width / 2.0, 20, "Joint bounds along the path: " + series.source + " (SI units: rad, m)", "middle",
-           14, " font-weight=\"bold\"");
-  // Legend.
-  struct Entry {
-    const char* label;
-    Rgb c;
-    const char* dash;
-  };
-  const Entry legend[] = {{"lower bound", kLower, ""},
-                          {"nominal", kNominal, ""},
-                          {"upper bound", kUpper, ""},
-                          {"before the safety stage (shrunk)", kGuide, " stroke-dasharray=\"5,3\""}};
-  double lx = 20;
-  for (const auto& e : legend) {
-    svg.line(lx, 40, lx + 24, 40, e.c.hex(), 2, e.dash);
-    svg.text(lx + 30, 44, e.label);
-    lx += 40 + 7.0 * static_cast<double>(std::strlen(e.label));
-  }
-  svg.raw("<circle cx=\"" + fixed(lx + 6) + "\" cy=\"40\" r=\"5\" fill=\"none\" stroke=\"" +
-          kCollapsed.hex() + "\" stroke-width=\"2\"/>\n");
-  svg.text(lx + 16, 44, "collapsed (widened by the guard)");
+namespace {
 
-  for (size_t k = 0; k < dof; ++k) {
-    const auto i = static_cast<Eigen::Index>(k);
-    const double px = static_cast<double>(k % static_cast<size_t>(cols)) * pw;
-    const double py = top + static_cast<double>(k / static_cast<size_t>(cols)) * ph;
-    const Area a{px + 64, py + 24, pw - 84, ph - 60};
-    double lo = series.q[0][i], hi = lo;
-    for (size_t w = 0; w < n; ++w) {
-      lo = std::min({lo, series.lower[w][i], series.guide_lower[w][i]});
-      hi = std::max({hi, series.upper[w][i], series.guide_upper[w][i]});
-    }
-    const auto [ylo, yhi] = padded(lo, hi);
-    auto x = [&a](double s) { return a.x + s * a.w; };
-    auto y = [&a, ylo = ylo, yhi = yhi](double v) { return a.y + a.h - (v - ylo) / (yhi - ylo) * a.h; };
-    svg.raw("<g class=\"joint\" data-joint=\"" + escape(series.joints[k]) + "\">\n");
-    const std::string kind = series.kinds[k].empty() ? "" : ", " + series.kinds[k];
-    svg.text(a.x + a.w / 2, py + 16, series.joints[k] + " [" + series.unit(k) + "]" + kind, "middle", 13,
-             " font-weight=\"bold\"");
-    const std::vector<double> xt = {0, 0.25, 0.5, 0.75, 1}, yt = nice_ticks(ylo, yhi, 4);
-    axes(svg, a, xt, labels(xt), yt, labels(yt), x, y);
-    svg.text(a.x + a.w / 2, a.y + a.h + 30,
-             "path parameter s = k / (n - 1) at waypoint k; lines join the waypoints", "middle", 10);
-    // The band between the bounds.
-    std::string d = "M";
-    for (size_t w = 0; w < n; ++w) d += " " + fixed(x(series.s[w])) + "," + fixed(y(series.upper[w][i]));
-    for (size_t w = n; w-- > 0;) d += " L " + fixed(x(series.s[w])) + "," + fixed(y(series.lower[w][i]));
-    svg.raw("<path class=\"band\" d=\"" + d + " Z\" fill=\"" + kBand.hex() +
-            "\" fill-opacity=\"0.5\" stroke=\"none\"/>\n");
-    auto pts = [&](const std::vector<Eigen::VectorXd>& v) {
-      std::vector<std::pair<double, double>> out;
-      for (size_t w = 0; w < n; ++w) out.emplace_back(x(series.s[w]), y(v[w][i]));
-      return out;
-    };
-    bool shrunk = false;
-    for (size_t w = 0; w < n; ++w) shrunk = shrunk || series.shrunk(w, k);
-    if (shrunk) {
-      svg.polyline(pts(series.guide_lower), "guide-lower", kGuide, 1.5, " stroke-dasharray=\"5,3\"");
-      svg.polyline(pts(series.guide_upper), "guide-upper", kGuide, 1.5, " stroke-dasharray=\"5,3\"");
-    }
-    svg.polyline(pts(series.lower), "lower", kLower, 2);
-    svg.polyline(pts(series.q), "nominal", kNominal, 1.5);
-    svg.polyline(pts(series.upper), "upper", kUpper, 2);
-    // Single points (a one-waypoint file) and the waypoints themselves as dots on the bounds.
-    for (size_t w = 0; w < n; ++w) {
-      for (const auto* v : {&series.lower, &series.upper})
-        svg.raw("<circle class=\"waypoint\" cx=\"" + fixed(x(series.s[w])) + "\" cy=\"" +
-                fixed(y((*v)[w][i])) + "\" r=\"2.5\" fill=\"" + (v == &series.lower ? kLower : kUpper).hex() +
-                "\"/>\n");
-      if (series.collapsed[w][k])
-        svg.raw("<circle class=\"collapsed\" cx=\"" + fixed(x(series.s[w])) + "\" cy=\"" +
-                fixed(y(series.q[w][i])) + "\" r=\"6\" fill=\"none\" stroke=\"" + kCollapsed.hex() +
-                "\" stroke-width=\"2\"><title>waypoint " + std::to_string(w) +
-                ": collapsed, widened by the guard</title></circle>\n");
-    }
-    svg.raw("</g>\n");
+// The x value of waypoint w: its time [s] or its path parameter s.
+double x_of(const BoundsSeries& series, bool time, size_t w) { return time ? series.t[w] : series.s[w]; }
+
+// The y range of joint k's panel: the band (bounds and nominal) plus a margin of half its height
+// on either side, widened to the guide bounds only as far as that margin, so that a guide spanning
+// the whole joint range does not squeeze the certified band into a sliver. Padded by 5 %.
+std::pair<double, double> joint_range(const BoundsSeries& series, size_t k) {
+  const auto i = static_cast<Eigen::Index>(k);
+  double blo = series.q[0][i], bhi = blo, glo = blo, ghi = blo;
+  for (size_t w = 0; w < series.q.size(); ++w) {
+    blo = std::min(blo, series.lower[w][i]);
+    bhi = std::max(bhi, series.upper[w][i]);
+    glo = std::min(glo, series.guide_lower[w][i]);
+    ghi = std::max(ghi, series.guide_upper[w][i]);
   }
-  return svg.str();
+  const double margin = bhi > blo ? 0.5 * (bhi - blo) : 0.1;
+  return padded(std::min(blo, std::max(glo, blo - margin)), std::max(bhi, std::min(ghi, bhi + margin)));
 }
 
-Image bounds_image(const BoundsSeries& series, int width, int height) {
+void bounds_legend(Drawing& d, const BoundsSeries& series, bool time) {
+  d.label(d.width / 2.0, 20,
+          "Joint bounds along the path: " + series.source + " (SI units: rad, m" + (time ? ", s)" : ")"), 14,
+          1, true);
+  double lx = 20;
+  lx = legend_line(d, lx, "lower bound", kLower, {});
+  lx = legend_line(d, lx, "nominal", kNominal, {});
+  lx = legend_line(d, lx, "upper bound", kUpper, {});
+  lx = legend_line(d, lx, "before the safety stage (shrunk)", kGuide, kGuideDash);
+  d.circle(lx + 6, 40, 5, kCollapsed, false, 2);
+  d.label(lx + 16, 44, "collapsed (widened by the guard)", 12);
+}
+
+// The guide bounds of joint k, clamped to the panel; a triangle at the panel's edge marks each
+// waypoint whose guide bound lies beyond the axis (pointing up at the top, down at the bottom).
+template <class X, class Y>
+void guide_lines(Drawing& d, const BoundsSeries& series, size_t k, const Area& a, bool time, X&& x, Y&& y,
+                 double ylo, double yhi) {
+  const auto i = static_cast<Eigen::Index>(k);
+  bool clipped = false;
+  for (const auto* v : {&series.guide_lower, &series.guide_upper}) {
+    Points pts;
+    for (size_t w = 0; w < series.q.size(); ++w) {
+      const double value = (*v)[w][i], px = x(x_of(series, time, w));
+      pts.emplace_back(px, y(std::clamp(value, ylo, yhi)));
+      if (value > yhi)
+        d.polygon({{px - 4, a.y + 7}, {px + 4, a.y + 7}, {px, a.y + 1}}, kGuide, 1, "guide-clipped");
+      if (value < ylo)
+        d.polygon({{px - 4, a.y + a.h - 7}, {px + 4, a.y + a.h - 7}, {px, a.y + a.h - 1}}, kGuide, 1,
+                  "guide-clipped");
+      clipped = clipped || value > yhi || value < ylo;
+    }
+    d.polyline(pts, kGuide, 1.5, kGuideDash, v == &series.guide_lower ? "guide-lower" : "guide-upper");
+  }
+  if (clipped) d.label(a.x + a.w - 4, a.y + 14, "guide clipped at the edge", 10, 2, false, "clip-note");
+}
+
+void bounds_panel(Drawing& d, const BoundsSeries& series, size_t k, const Area& a, bool time, double py) {
+  const auto i = static_cast<Eigen::Index>(k);
+  const size_t n = series.q.size();
+  const auto [ylo, yhi] = joint_range(series, k);
+  const double xmax = time ? series.t.back() : 1.0;
+  auto x = [&a, xmax](double v) { return a.x + v / xmax * a.w; };
+  auto y = [&a, ylo = ylo, yhi = yhi](double v) { return a.y + a.h - (v - ylo) / (yhi - ylo) * a.h; };
+  d.group("class=\"joint\" data-joint=\"" + detail::xml_escape(series.joints[k]) + "\"");
+  const std::string kind = series.kinds[k].empty() ? "" : ", " + series.kinds[k];
+  d.label(a.x + a.w / 2, py + 16, series.joints[k] + " [" + series.unit(k) + "]" + kind, 13, 1, true);
+  axes(d, a, detail::nice_ticks(0, xmax, 5), detail::nice_ticks(ylo, yhi, 4), x, y);
+  d.label(a.x + a.w / 2, a.y + a.h + 30,
+          time ? "time t [s]; lines join the waypoints"
+               : "path parameter s = k / (n - 1) [1]; lines join the waypoints",
+          10, 1);
+  auto pts = [&](const std::vector<Eigen::VectorXd>& v) {
+    Points out;
+    for (size_t w = 0; w < n; ++w) out.emplace_back(x(x_of(series, time, w)), y(v[w][i]));
+    return out;
+  };
+  Points band = pts(series.upper), lower = pts(series.lower);
+  band.insert(band.end(), lower.rbegin(), lower.rend());
+  d.polygon(band, kBand, kBandOpacity, "band");
+  bool shrunk = false;
+  for (size_t w = 0; w < n; ++w) shrunk = shrunk || series.shrunk(w, k);
+  if (shrunk) guide_lines(d, series, k, a, time, x, y, ylo, yhi);
+  d.polyline(lower, kLower, 2, {}, "lower");
+  d.polyline(pts(series.q), kNominal, 1.5, {}, "nominal");
+  d.polyline(pts(series.upper), kUpper, 2, {}, "upper");
+  for (size_t w = 0; w < n; ++w) {  // the waypoints as dots on the bounds (a single one is a dot)
+    d.circle(x(x_of(series, time, w)), y(series.lower[w][i]), 2.5, kLower, true, 0, "waypoint");
+    d.circle(x(x_of(series, time, w)), y(series.upper[w][i]), 2.5, kUpper, true, 0, "waypoint");
+    if (series.collapsed[w][k])
+      d.circle(x(x_of(series, time, w)), y(series.q[w][i]), 6, kCollapsed, false, 2, "collapsed",
+               "waypoint " + std::to_string(w) + ": collapsed, widened by the guard");
+  }
+  d.end_group();
+}
+
+}  // namespace
+
+namespace detail {
+
+Drawing bounds_drawing(const BoundsSeries& series, int width, int height, PlotX x_axis) {
   detail::check_image_size(width, height, "plot size");
-  const size_t dof = series.joints.size(), n = series.q.size();
+  const size_t dof = series.joints.size();
   const int cols = dof > 3 ? 2 : 1;
   const int rows = static_cast<int>((dof + static_cast<size_t>(cols) - 1) / static_cast<size_t>(cols));
-  ModelPtr model = empty_model();
-  detail::OffscreenContext gl(*model, width, height);
-  mjr_rectangle(gl.viewport(), 1, 1, 1, 1);
-  const int top = 64;
-  title_band(gl, "Joint bounds along the path (SI units: rad, m): " + series.source,
-             "lower: blue, nominal: black, upper: red, before the safety stage: grey, collapsed: orange");
+  check_panels(width, height, cols, rows, std::to_string(dof) + " joint panels");
+  const bool time = x_axis == PlotX::kTime && series.has_times();
+  const double pw = static_cast<double>(width) / cols, ph = (height - kTop) / rows;
+  Drawing d;
+  d.width = width;
+  d.height = height;
+  bounds_legend(d, series, time);
   for (size_t k = 0; k < dof; ++k) {
-    const auto i = static_cast<Eigen::Index>(k);
-    const std::string kind = series.kinds[k].empty() ? "" : ", " + series.kinds[k];
-    auto fig = new_figure(series.joints[k] + " [" + series.unit(k) + "]" + kind, "path parameter s");
-    int lines = 0;
-    auto pts = [&](const std::vector<Eigen::VectorXd>& v) {
-      std::vector<std::pair<double, double>> out;
-      for (size_t w = 0; w < n; ++w) out.emplace_back(series.s[w], v[w][i]);
-      return out;
-    };
-    double lo = series.q[0][i], hi = lo;
-    bool shrunk = false;
-    for (size_t w = 0; w < n; ++w) {
-      lo = std::min({lo, series.lower[w][i], series.guide_lower[w][i]});
-      hi = std::max({hi, series.upper[w][i], series.guide_upper[w][i]});
-      shrunk = shrunk || series.shrunk(w, k);
-    }
-    const auto [ylo, yhi] = padded(lo, hi);
-    fig->range[0][0] = 0;
-    fig->range[0][1] = 1;
-    fig->range[1][0] = static_cast<float>(ylo);
-    fig->range[1][1] = static_cast<float>(yhi);
-    add_line(*fig, lines, "lower", kLower, pts(series.lower));
-    add_line(*fig, lines, "nominal", kNominal, pts(series.q));
-    add_line(*fig, lines, "upper", kUpper, pts(series.upper));
-    if (shrunk) {
-      add_line(*fig, lines, "before safety", kGuide, pts(series.guide_lower));
-      add_line(*fig, lines, "", kGuide, pts(series.guide_upper));
-    }
-    // Collapsed intervals: a short vertical mark through the nominal value.
-    bool named = false;
-    for (size_t w = 0; w < n; ++w)
-      if (series.collapsed[w][k]) {
-        const double h = 0.06 * (yhi - ylo);
-        add_line(*fig, lines, named ? "" : "collapsed", kCollapsed,
-                 {{series.s[w], series.q[w][i] - h}, {series.s[w], series.q[w][i] + h}});
-        named = true;
-      }
-    mjr_figure(cell_rect(static_cast<int>(k), cols, rows, width, height, top), fig.get(), &gl.mjr());
+    const double px = static_cast<double>(k % static_cast<size_t>(cols)) * pw;
+    const double py = kTop + static_cast<double>(k / static_cast<size_t>(cols)) * ph;
+    bounds_panel(d, series, k, {px + 64, py + 24, pw - 84, ph - 60}, time, py);
   }
-  return gl.read();
+  return d;
+}
+
+}  // namespace detail
+
+std::string bounds_svg(const BoundsSeries& series, int width, int height, PlotX x) {
+  return detail::to_svg(detail::bounds_drawing(series, width, height, x));
+}
+
+Image bounds_image(const BoundsSeries& series, int width, int height, PlotX x) {
+  return detail::to_image(detail::bounds_drawing(series, width, height, x));
 }
 
 // ---------------------------------------------------------------------------------------------
 // Sweep plots.
 
+// ---------------------------------------------------------------------------------------------
+// Sweep plots.
+
 namespace {
+
+// A whole field as a number, read with '.' as the decimal point whatever the locale (std::stod
+// follows the C locale's LC_NUMERIC); "nan" and "inf" read as such, for the finiteness check.
+bool parse_number(const std::string& text, double& v) {
+  const char* end = text.data() + text.size();
+  const auto r = std::from_chars(text.data() + (!text.empty() && text[0] == '+'), end, v);
+  return !text.empty() && r.ec == std::errc() && r.ptr == end;
+}
 
 // The fields of one CSV line as a spreadsheet writes them back: a field may be quoted ("a,b",
 // with "" for a quote inside), spaces around a field are dropped, a line may end in CR (CRLF).
@@ -487,13 +374,7 @@ SweepSeries read_sweep_csv(const std::string& path) {
       const std::string where =
           path + ": line " + std::to_string(number) + " column '" + header[col[k]] + "'";
       if (col[k] >= f.size()) throw InputError(where + " is missing");
-      try {
-        size_t used = 0;
-        v[k] = std::stod(f[col[k]], &used);
-        if (used != f[col[k]].size()) throw std::invalid_argument("trailing text");
-      } catch (const std::exception&) {
-        throw InputError(where + ": '" + f[col[k]] + "' is not a number");
-      }
+      if (!parse_number(f[col[k]], v[k])) throw InputError(where + ": '" + f[col[k]] + "' is not a number");
       if (!std::isfinite(v[k])) throw InputError(where + ": '" + f[col[k]] + "' is not a finite number");
     }
     if (v[0] < 1 || v[0] != std::floor(v[0]) || v[0] > kMaxCellsLimit)
@@ -518,7 +399,9 @@ std::vector<SweepPoint> thesis_table(const std::string& cell, const std::string&
     LEEWAY_DEMAND(f.size() == 7);
     if (f[1] != cell || f[2] != path) continue;
     if (table) *table = f[0];
-    out.push_back({std::stoi(f[3]), std::stod(f[4]), std::stod(f[5]), std::stod(f[6])});
+    double v[4] = {};
+    for (size_t k = 0; k < 4; ++k) LEEWAY_DEMAND(parse_number(f[3 + k], v[k]));
+    out.push_back({static_cast<int>(v[0]), v[1], v[2], v[3]});
   }
   return out;
 }
@@ -552,19 +435,68 @@ double safe_log(double v) { return std::log10(std::max(v, 1e-3)); }
 
 }  // namespace
 
-std::string sweep_svg(const std::vector<SweepSeries>& series, const std::string& title, int width,
-                      int height) {
-  check_sweep(series, width, height);
-  Svg svg(width, height);
-  svg.text(width / 2.0, 20, title, "middle", 14, " font-weight=\"bold\"");
-  // Legend.
-  double lx = 20;
+namespace {
+
+// Decades lo .. hi as ticks labelled 10^e (0.01, 1, 1000).
+Ticks decade_ticks(double lo, double hi) {
+  Ticks t;
+  for (auto e = static_cast<int>(std::lround(lo)); e <= static_cast<int>(std::lround(hi)); ++e) {
+    t.values.push_back(e);
+    t.labels.push_back(detail::format_fixed(std::pow(10.0, e), std::max(0, -e)));
+  }
+  return t;
+}
+
+void sweep_panel(Drawing& d, const std::vector<SweepSeries>& series, const Quantity& q, const Area& a,
+                 double xmin, double xmax) {
+  double lo = 1e300, hi = -1e300;
+  for (const auto& s : series)
+    for (const auto& p : s.points) {
+      const double v = q.log ? safe_log(p.*q.value) : p.*q.value;
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+  if (q.log) {
+    lo = std::floor(lo);
+    hi = std::max(std::ceil(hi), lo + 1);
+  } else {
+    std::tie(lo, hi) = padded(lo, hi);
+  }
+  auto x = [&](double v) { return a.x + (v - xmin) / (xmax - xmin) * a.w; };
+  auto y = [&](double v) { return a.y + a.h - (v - lo) / (hi - lo) * a.h; };
+  d.group(std::string("class=\"panel\" data-quantity=\"") + q.key + "\"");
+  d.label(a.x + a.w / 2, kTop + 16, std::string(q.title) + (q.log ? " (log scale)" : ""), 13, 1, true);
+  axes(d, a, decade_ticks(xmin, xmax), q.log ? decade_ticks(lo, hi) : detail::nice_ticks(lo, hi, 5), x, y);
+  d.label(a.x + a.w / 2, a.y + a.h + 30, "MAX_cells (log scale)", 10, 1);
   for (size_t s = 0; s < series.size(); ++s) {
     const Rgb c = kSeries[s % std::size(kSeries)];
-    svg.line(lx, 40, lx + 24, 40, c.hex(), 2, s ? " stroke-dasharray=\"6,3\"" : "");
-    svg.text(lx + 30, 44, series[s].label);
-    lx += 50 + 7.0 * static_cast<double>(series[s].label.size());
+    Points pts;
+    for (const auto& p : series[s].points)
+      pts.emplace_back(x(std::log10(p.max_cells)), y(q.log ? safe_log(p.*q.value) : p.*q.value));
+    d.polyline(pts, c, 2, s ? kSeriesDash : std::vector<double>{}, "series",
+               "data-series=\"" + detail::xml_escape(series[s].label) + "\"");
+    for (const auto& [px, py] : pts) d.circle(px, py, 3, c, true, 0);
   }
+  d.end_group();
+}
+
+}  // namespace
+
+namespace detail {
+
+Drawing sweep_drawing(const std::vector<SweepSeries>& series, const std::string& title, int width,
+                      int height) {
+  check_sweep(series, width, height);
+  check_panels(width, height, 3, 1, "3 panels");
+  Drawing d;
+  d.width = width;
+  d.height = height;
+  d.label(width / 2.0, 20, title, 14, 1, true);
+  double lx = 20;
+  for (size_t s = 0; s < series.size(); ++s)
+    lx = legend_line(d, lx, series[s].label, kSeries[s % std::size(kSeries)],
+                     s ? kSeriesDash : std::vector<double>{}) +
+         10;
   double xmin = 1e300, xmax = -1e300;
   for (const auto& s : series)
     for (const auto& p : s.points) {
@@ -573,89 +505,22 @@ std::string sweep_svg(const std::vector<SweepSeries>& series, const std::string&
     }
   xmin = std::floor(xmin);
   xmax = std::max(std::ceil(xmax), xmin + 1);
-  const double top = 58, pw = width / 3.0;
-  for (size_t qi = 0; qi < std::size(kQuantities); ++qi) {
-    const Quantity& q = kQuantities[qi];
-    const Area a{static_cast<double>(qi) * pw + 60, top + 24, pw - 80, height - top - 70};
-    double lo = 1e300, hi = -1e300;
-    for (const auto& s : series)
-      for (const auto& p : s.points) {
-        const double v = q.log ? safe_log(p.*q.value) : p.*q.value;
-        lo = std::min(lo, v);
-        hi = std::max(hi, v);
-      }
-    if (q.log) {
-      lo = std::floor(lo);
-      hi = std::max(std::ceil(hi), lo + 1);
-    } else {
-      std::tie(lo, hi) = padded(lo, hi);
-    }
-    auto x = [&](double v) { return a.x + (v - xmin) / (xmax - xmin) * a.w; };
-    auto y = [&](double v) { return a.y + a.h - (v - lo) / (hi - lo) * a.h; };
-    std::vector<double> xt, yt;
-    std::vector<std::string> xl, yl;
-    for (double e = xmin; e <= xmax + 1e-9; e += 1) {
-      xt.push_back(e);
-      xl.push_back(tick_label(std::pow(10.0, e)));
-    }
-    if (q.log) {
-      for (double e = lo; e <= hi + 1e-9; e += 1) {
-        yt.push_back(e);
-        yl.push_back(tick_label(std::pow(10.0, e)));
-      }
-    } else {
-      yt = nice_ticks(lo, hi, 5);
-      yl = labels(yt);
-    }
-    svg.raw(std::string("<g class=\"panel\" data-quantity=\"") + q.key + "\">\n");
-    svg.text(a.x + a.w / 2, top + 16, std::string(q.title) + (q.log ? " (log scale)" : ""), "middle", 13,
-             " font-weight=\"bold\"");
-    axes(svg, a, xt, xl, yt, yl, x, y);
-    svg.text(a.x + a.w / 2, a.y + a.h + 30, "MAX_cells (log scale)", "middle", 10);
-    for (size_t s = 0; s < series.size(); ++s) {
-      const Rgb c = kSeries[s % std::size(kSeries)];
-      std::vector<std::pair<double, double>> pts;
-      for (const auto& p : series[s].points)
-        pts.emplace_back(x(std::log10(p.max_cells)), y(q.log ? safe_log(p.*q.value) : p.*q.value));
-      const std::string attr =
-          " data-series=\"" + escape(series[s].label) + "\"" + (s ? " stroke-dasharray=\"6,3\"" : "");
-      svg.polyline(pts, "series", c, 2, attr.c_str());
-      for (const auto& [px, py] : pts)
-        svg.raw("<circle cx=\"" + fixed(px) + "\" cy=\"" + fixed(py) + "\" r=\"3\" fill=\"" + c.hex() +
-                "\"/>\n");
-    }
-    svg.raw("</g>\n");
-  }
-  return svg.str();
+  const double pw = width / 3.0;
+  for (size_t qi = 0; qi < std::size(kQuantities); ++qi)
+    sweep_panel(d, series, kQuantities[qi],
+                {static_cast<double>(qi) * pw + 60, kTop + 24, pw - 80, height - kTop - 70}, xmin, xmax);
+  return d;
+}
+
+}  // namespace detail
+
+std::string sweep_svg(const std::vector<SweepSeries>& series, const std::string& title, int width,
+                      int height) {
+  return detail::to_svg(detail::sweep_drawing(series, title, width, height));
 }
 
 Image sweep_image(const std::vector<SweepSeries>& series, const std::string& title, int width, int height) {
-  check_sweep(series, width, height);
-  ModelPtr model = empty_model();
-  detail::OffscreenContext gl(*model, width, height);
-  mjr_rectangle(gl.viewport(), 1, 1, 1, 1);
-  const int top = 64;
-  std::string legend;
-  const char* const kNames[] = {"blue", "orange", "green", "purple"};
-  for (size_t s = 0; s < series.size(); ++s)
-    legend += (s ? ", " : "") + series[s].label + ": " + kNames[s % std::size(kNames)];
-  title_band(gl, title, legend);
-  for (size_t qi = 0; qi < std::size(kQuantities); ++qi) {
-    const Quantity& q = kQuantities[qi];
-    auto fig = new_figure(std::string(q.title) + (q.log ? " (log10)" : ""), "log10 MAX_cells");
-    fig->flg_extend = 1;
-    fig->range[0][0] = fig->range[0][1] = 0;  // min >= max: automatic
-    fig->range[1][0] = fig->range[1][1] = 0;
-    int lines = 0;
-    for (size_t s = 0; s < series.size(); ++s) {
-      std::vector<std::pair<double, double>> pts;
-      for (const auto& p : series[s].points)
-        pts.emplace_back(std::log10(p.max_cells), q.log ? safe_log(p.*q.value) : p.*q.value);
-      add_line(*fig, lines, series[s].label, kSeries[s % std::size(kSeries)], pts);
-    }
-    mjr_figure(cell_rect(static_cast<int>(qi), 3, 1, width, height, top), fig.get(), &gl.mjr());
-  }
-  return gl.read();
+  return detail::to_image(detail::sweep_drawing(series, title, width, height));
 }
 
 }  // namespace leeway

@@ -2,7 +2,8 @@
 //! @file plot.hpp
 //! Plots: each joint's bounds along the path (the thesis's figs. 4.4-4.16), and a
 //! sweep's boxes, time and CF against MAX_cells (tables 4.1-4.9) beside the thesis's published
-//! values. Written as SVG directly, or as PNG through MuJoCo's figure renderer (offscreen, OSMesa).
+//! values. Each plot is drawn once and written as SVG or as a PNG rasterised by leeway itself (no
+//! OpenGL), with the same content; numbers are written the same under any locale.
 
 #include <Eigen/Core>
 #include <string>
@@ -23,6 +24,10 @@ struct BoundsSeries {
   //! Path parameter of each waypoint: s = k / (n - 1) (the joint-linear interpolation parameter on
   //! a path between two keyframes; the waypoint index's fraction on a planned path).
   std::vector<double> s;
+  //! Time of each waypoint [s] (format 2's `t`); empty when a waypoint has none.
+  std::vector<double> t;
+  //! True when every waypoint has a time and the path lasts longer than 0 s.
+  bool has_times() const { return !t.empty() && t.back() > 0; }
   //! Joint k's unit: "m" for the linear axis, "rad" otherwise.
   std::string unit(size_t k) const { return kinds[k] == "linear_axis" ? "m" : "rad"; }
   //! True when the safety stage shrank joint k's interval at waypoint w.
@@ -31,18 +36,25 @@ struct BoundsSeries {
 
 //! Reads the series of a bounds file (format leeway-bounds-1, or older files without guide bounds).
 //! @throws InputError naming the file, waypoint and joint on a malformed file, sizes that differ,
-//! non-finite values or lower > nominal > upper.
+//! non-finite values, lower > nominal > upper, or times `t` that are not finite, start below 0 or
+//! decrease.
 BoundsSeries read_bounds_series(const std::string& path);
+
+//! The bounds plot's x axis: time t [s] (when the file has times, else s) or the path parameter s.
+enum class PlotX { kTime, kPathParameter };
 
 //! The bounds plot as SVG: one panel per joint with the band between lower and upper, the nominal,
 //! the guide bounds where the safety stage shrank the interval, and collapsed intervals marked.
 //! Every joint's panel is a `<g class="joint" data-joint="NAME">` holding polylines of class
-//! `lower`, `nominal` and `upper`. @throws InputError on a size outside 16 .. 8192 pixels.
-std::string bounds_svg(const BoundsSeries& series, int width, int height);
+//! `lower`, `nominal` and `upper`, a `<path class="band">`, and `guide-lower`/`guide-upper` where
+//! shrunk. A panel's y range is the band plus half its height on either side: guide bounds beyond
+//! it run along the panel's edge, each such waypoint marked by a grey triangle (class
+//! `guide-clipped`) pointing out of the panel. @throws InputError on a size outside 16 .. 8192
+//! pixels or too small for the panels (200 x 160 pixels each below a 58-pixel title band).
+std::string bounds_svg(const BoundsSeries& series, int width, int height, PlotX x = PlotX::kTime);
 
-//! The bounds plot as an image (MuJoCo's mjr_figure, one figure per joint).
-//! @throws InputError on a size outside 16 .. 8192 pixels; std::runtime_error without OpenGL.
-Image bounds_image(const BoundsSeries& series, int width, int height);
+//! The bounds plot as an image: the same drawing as bounds_svg, rasterised. @throws as bounds_svg.
+Image bounds_image(const BoundsSeries& series, int width, int height, PlotX x = PlotX::kTime);
 
 //! One row of a sweep: MAX_cells, boxes, total time [ms] and CF [%].
 struct SweepPoint {
@@ -70,12 +82,12 @@ std::vector<SweepPoint> thesis_table(const std::string& cell, const std::string&
 
 //! The sweep plot as SVG: three panels (boxes, time [ms], CF [%]) against MAX_cells on a log axis,
 //! one `<polyline class="series" data-series="LABEL">` per series and panel.
-//! @throws InputError on a size outside 16 .. 8192 pixels or no series with points.
+//! @throws InputError on a size outside 16 .. 8192 pixels, below 600 x 218 pixels, or no series with
+//! points.
 std::string sweep_svg(const std::vector<SweepSeries>& series, const std::string& title, int width,
                       int height);
 
-//! The sweep plot as an image (MuJoCo's mjr_figure; x is log10 MAX_cells).
-//! @throws InputError as sweep_svg; std::runtime_error without OpenGL.
+//! The sweep plot as an image: the same drawing as sweep_svg, rasterised. @throws as sweep_svg.
 Image sweep_image(const std::vector<SweepSeries>& series, const std::string& title, int width, int height);
 
 }  // namespace leeway

@@ -64,7 +64,7 @@ class CliRenderTest : public test::MujocoTest {
 
 TEST_F(CliRenderTest, VolumeColourWhereAVolumeBoxProjectsAndNotWithVolumeOff) {
   const std::string b = bounds_file();
-  const std::string camera = " --size 320x240 --camera 0,-1.5,14 --lookat 0,0,0";
+  const std::string camera = " --size 320x240 --camera 0,-1.5,14 --lookat 0,0,0 --legend off";
   const auto on = run_cli("render " + workcell("dallara") + " --bounds " + b + " --out " + path("on.png") +
                           camera + " --volume on");
   ASSERT_EQ(on.exit_code, 0) << on.out;
@@ -166,6 +166,30 @@ TEST_F(CliRenderTest, StripFramesAreThePathsWaypointsAtItsEnds) {
   EXPECT_GT(middle, 0);
 }
 
+// The legend band (on by default from 320 x 176 pixels) fills the image's last 56 rows: the colour
+// scale starts at the lowest height's colour at (11, 240 + 14) of a 400 x 300 picture.
+TEST_F(CliRenderTest, LegendBandUnderThePicture) {
+  const std::string b = bounds_file();
+  const auto r =
+      run_cli("render " + workcell("dallara") + " --bounds " + b + " --size 400x300 --out " + path("l.png"));
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const Image img = test::read_png(path("l.png"));
+  ASSERT_EQ(img.height, 300);
+  const BoundsFileVolume v = read_bounds_volume(b, Scene::load(workcell("dallara")));
+  double top = 0;
+  for (const Box& box : v.volume.boxes) top = std::max(top, box.center.z() + box.half_size.z());
+  const auto c = height_colour(0.5 / 64 * top, top);
+  const auto px = img.at(11, 300 - kLegendHeight + 14);
+  for (int k = 0; k < 3; ++k)
+    EXPECT_NEAR(px[static_cast<size_t>(k)], 255 * c[static_cast<size_t>(k)], 3) << k;
+  // Without it the picture reaches the last row: no white band there.
+  const auto off = run_cli("render " + workcell("dallara") + " --bounds " + b +
+                           " --size 400x300 --legend off --out " + path("n.png"));
+  ASSERT_EQ(off.exit_code, 0) << off.out;
+  const Image none = test::read_png(path("n.png"));
+  EXPECT_NE(none.at(11, 300 - kLegendHeight + 14), img.at(11, 300 - kLegendHeight + 14));
+}
+
 TEST(TileTest, SideBySideRowByRow) {
   Image a, b;
   a.width = 1;
@@ -226,6 +250,7 @@ TEST_F(CliRenderTest, BadInputExitsTwoAndWritesNothing) {
       {cell + " --out " + out + " --lookat 0,0,inf", "--lookat"},
       {cell + " --out " + out + " --volume maybe", "--volume 'maybe' must be fade, on or off"},
       {cell + " --out " + out + " --frame nowhere", "--frame 'nowhere' must be robot or volume"},
+      {cell + " --out " + out + " --legend maybe", "--legend 'maybe' must be on or off"},
       {workcell("dallara") + " --out " + out + " --strip 3",
        "--strip 3: there is no path without --bounds or --from/--to"},
       {cell + " --out " + out + " --strip 1", "--strip 1 must be within 2 .. 64"},

@@ -10,6 +10,7 @@
 #include "leeway/core/error.hpp"
 #include "png_util.hpp"
 #include "test_util.hpp"
+#include "viz/canvas.hpp"
 
 namespace leeway {
 namespace {
@@ -285,6 +286,43 @@ TEST_F(RenderTest, VolumeBoxesAroundTheRobotAreFaded) {
   r.faded_alpha = 1.5;
   r.volume = {box};
   EXPECT_THROW(render_scene(s, r), InputError);
+}
+
+// The legend band: the colour scale 240 pixels wide from x = 10 in 64 steps (step i coloured at the
+// height (i + 0.5) / 64 of the top), 8 to 20 pixels down; then, 24 pixels on, the ghosts' swatches
+// (14 x 12 pixels, tinted as the ghosts: lower (0.35, 0.60, 0.95), upper (0.95, 0.35, 0.35)).
+TEST(LegendTest, ColourScaleAndGhostTintsWhereWorkedOut) {
+  const Image img = render_legend(640, 2.0, true, true);
+  ASSERT_EQ(img.width, 640);
+  ASSERT_EQ(img.height, kLegendHeight);
+  auto near = [](const std::array<unsigned char, 3>& px, double r, double g, double b) {
+    return std::abs(px[0] - 255 * r) <= 3 && std::abs(px[1] - 255 * g) <= 3 && std::abs(px[2] - 255 * b) <= 3;
+  };
+  const auto first = height_colour(0.5 / 64 * 2.0, 2.0), last = height_colour(63.5 / 64 * 2.0, 2.0);
+  EXPECT_TRUE(near(img.at(11, 14), first[0], first[1], first[2]));
+  EXPECT_TRUE(near(img.at(248, 14), last[0], last[1], last[2]));
+  EXPECT_TRUE(near(img.at(281, 14), 0.35, 0.60, 0.95));
+  const double second = 274 + 26 + detail::text_width("ghost: joints at lower bound", 9);
+  EXPECT_TRUE(near(img.at(static_cast<int>(second) + 7, 14), 0.95, 0.35, 0.35));
+  // No volume and no ghosts: white where the scale and the swatch were.
+  const Image bare = render_legend(640, 0, false, false);
+  EXPECT_TRUE(near(bare.at(11, 14), 1, 1, 1));
+  EXPECT_TRUE(near(bare.at(281, 14), 1, 1, 1));
+  EXPECT_THROW(render_legend(8, 1, true, true), InputError);
+}
+
+TEST(LegendTest, StackedTopToBottom) {
+  Image a, b;
+  a.width = b.width = 1;
+  a.height = 1;
+  b.height = 2;
+  a.rgb = {1, 1, 1};
+  b.rgb = {2, 2, 2, 3, 3, 3};
+  const Image s = stack_vertically({a, b});
+  EXPECT_EQ(s.height, 3);
+  EXPECT_EQ(s.rgb, (std::vector<unsigned char>{1, 1, 1, 2, 2, 2, 3, 3, 3}));
+  b.width = 2;
+  EXPECT_THROW(stack_vertically({a, b}), InputError);
 }
 
 TEST_F(RenderTest, BadSizesCamerasAndConfigurations) {

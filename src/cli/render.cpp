@@ -23,6 +23,9 @@ constexpr double kNearObstacles = 0.3;
 constexpr double kFadeMargin = 0.05;
 // --strip: at most this many frames.
 constexpr int kMaxStrip = 64;
+// --legend on: drawn on images at least this wide [pixels], leaving a picture at least this high.
+constexpr int kLegendMinWidth = 320;
+constexpr int kLegendMinPicture = 120;
 
 // The robot's base on the floor at q: the first hinge joint's anchor (the reach circle's centre).
 Eigen::Vector2d arm_base(const Scene& scene, const Eigen::VectorXd& q) {
@@ -79,6 +82,11 @@ CLI::App* add_render(CLI::App& app, RenderArgs& args) {
   sub->add_option("--strip", args.strip,
                   "K frames at evenly spaced nominal times along the path, side by side in one image\n"
                   "(--size is the whole image; with --bounds or --from/--to)");
+  sub->add_option(
+         "--legend", args.legend,
+         "A legend band under the picture (the volume's colour scale in metres, the ghosts' tints):\n"
+         "on or off (none below 320x176 pixels)")
+      ->capture_default_str();
   sub->add_option("--ghosts", args.ghosts,
                   "Ghosts of the robot: corners (all joints at their lower, all at their upper bound),\n"
                   "joints (each joint at each bound) or none")
@@ -222,6 +230,8 @@ RenderCamera default_camera(const RenderArgs& args, const Scene& scene, const Pa
 void check_render_args(const RenderArgs& args) {
   if (args.volume != "fade" && args.volume != "on" && args.volume != "off")
     throw InputError("--volume '" + args.volume + "' must be fade, on or off");
+  if (args.legend != "on" && args.legend != "off")
+    throw InputError("--legend '" + args.legend + "' must be on or off");
   if (args.frame != "robot" && args.frame != "volume")
     throw InputError("--frame '" + args.frame + "' must be robot or volume");
   const bool with_path = !args.from.empty() || !args.to.empty();
@@ -262,6 +272,9 @@ int run_render(const RenderArgs& args) {
   }
   check_render_args(args);
   const int frame_width = args.strip > 0 ? width / args.strip : width;
+  const bool legend =
+      args.legend == "on" && width >= kLegendMinWidth && height >= kLegendHeight + kLegendMinPicture;
+  const int frame_height = legend ? height - kLegendHeight : height;
   if (frame_width < 16)
     throw InputError("--size " + args.size + " with --strip " + std::to_string(args.strip) +
                      " leaves frames " + std::to_string(frame_width) + " pixels wide (at least 16)");
@@ -288,7 +301,7 @@ int run_render(const RenderArgs& args) {
     robots.extend(robot_extent(scene, shown));
   }
   const RenderCamera framed = default_camera(args, scene, p, in->volume, robots, frames.front().q,
-                                             static_cast<double>(frame_width) / height);
+                                             static_cast<double>(frame_width) / frame_height);
   if (!camera_given) camera.distance = framed.distance;
   camera.lookat = args.lookat.empty() ? framed.lookat : lookat;
 
@@ -296,7 +309,7 @@ int run_render(const RenderArgs& args) {
   for (const Frame& f : frames) {
     RenderRequest request;
     request.width = frame_width;
-    request.height = height;
+    request.height = frame_height;
     request.camera = camera;
     request.q = f.q;
     request.ghosts = f.ghosts;
@@ -310,7 +323,14 @@ int run_render(const RenderArgs& args) {
     }
     images.push_back(render_scene(scene, request));
   }
-  const Image image = images.size() == 1 ? images.front() : tile_horizontally(images);
+  Image image = images.size() == 1 ? images.front() : tile_horizontally(images);
+  if (legend) {
+    double max_top = 0;
+    if (show_volume)
+      for (const Box& b : in->volume.boxes) max_top = std::max(max_top, b.center.z() + b.half_size.z());
+    image = stack_vertically(
+        {image, render_legend(image.width, max_top, !frames.front().ghosts.empty(), args.volume == "fade")});
+  }
   write_png(args.out, image);
   const std::string shown = n == 0           ? "no bounds"
                             : args.strip > 0 ? std::to_string(args.strip) + " frames along " + in->what

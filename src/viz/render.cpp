@@ -14,6 +14,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "canvas.hpp"
 #include "core/json_io.hpp"
 #include "leeway/core/categorize.hpp"
 #include "leeway/core/error.hpp"
@@ -270,6 +271,58 @@ RenderCamera frame_box(const Eigen::AlignedBox3d& region, const RenderCamera& di
   const double half_h = 0.5 * fovy, half_w = std::atan(aspect * std::tan(half_h));
   c.distance = 1.05 * radius / std::sin(std::min(half_h, half_w));
   return c;
+}
+
+Image render_legend(int width, double max_top, bool ghosts, bool faded) {
+  if (width < 16) throw InputError("legend width " + std::to_string(width) + " pixels is below 16");
+  detail::Drawing d;
+  d.width = width;
+  d.height = kLegendHeight;
+  double x = 10;
+  if (max_top > 0) {
+    // The colour scale: 64 steps of height_colour, ticks at nice heights below it.
+    constexpr int kSteps = 64;
+    const double bar = std::min(240.0, 0.4 * width);
+    for (int i = 0; i < kSteps; ++i) {
+      const auto c = height_colour((i + 0.5) / kSteps * max_top, max_top);
+      d.rect(x + bar * i / kSteps, 8, bar / kSteps + 0.5, 12, {c[0], c[1], c[2]}, {}, 0);
+    }
+    const detail::Ticks ticks = detail::nice_ticks(0, max_top, 4);
+    for (size_t i = 0; i < ticks.values.size(); ++i) {
+      const double tx = x + bar * ticks.values[i] / max_top;
+      d.polyline({{tx, 20}, {tx, 24}}, {0, 0, 0}, 1);
+      d.label(tx, 34, ticks.labels[i], 9, 1);
+    }
+    d.label(x, 48, "volume box top [m]", 9);
+    x += bar + 24;
+  }
+  auto swatch = [&](const detail::Rgb& c, const std::string& text) {
+    d.rect(x, 8, 14, 12, c, {0.3, 0.3, 0.3}, 1);
+    d.label(x + 20, 18, text, 9);
+    x += 26 + detail::text_width(text, 9);
+  };
+  if (ghosts) {
+    swatch({0.35, 0.60, 0.95}, "ghost: joints at lower bound");
+    swatch({0.95, 0.35, 0.35}, "ghost: joints at upper bound");
+  }
+  if (faded)
+    d.label(max_top > 0 ? 10 + std::min(240.0, 0.4 * width) + 24 : 10, 44,
+            "boxes around and in front of the robot faded", 9);
+  return detail::to_image(d);
+}
+
+Image stack_vertically(const std::vector<Image>& images) {
+  if (images.empty()) throw InputError("no image to stack");
+  Image out;
+  out.width = images.front().width;
+  for (const Image& i : images) {
+    if (i.width != out.width)
+      throw InputError("images of widths " + std::to_string(out.width) + " and " + std::to_string(i.width) +
+                       " cannot be stacked");
+    out.height += i.height;
+    out.rgb.insert(out.rgb.end(), i.rgb.begin(), i.rgb.end());
+  }
+  return out;
 }
 
 Image tile_horizontally(const std::vector<Image>& images) {

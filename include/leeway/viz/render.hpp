@@ -68,6 +68,17 @@ Eigen::AlignedBox3d robot_neighbourhood(const Scene& scene, const Eigen::Aligned
 RenderCamera frame_box(const Eigen::AlignedBox3d& region, const RenderCamera& direction, double fovy,
                        double aspect);
 
+//! Height of render_legend's band [pixels].
+constexpr int kLegendHeight = 56;
+
+//! The legend band under a render, `width` x kLegendHeight pixels on white: the volume's colour
+//! scale from 0 to `max_top` [m] with ticks (when max_top > 0), the two ghost tints (when
+//! `ghosts`), and a note on the faded boxes (when `faded`). @throws InputError on a width below 16.
+Image render_legend(int width, double max_top, bool ghosts, bool faded);
+
+//! Images of one width stacked, top to bottom. @throws InputError on no image or widths that differ.
+Image stack_vertically(const std::vector<Image>& images);
+
 //! Images of one height side by side, left to right. @throws InputError on no image or heights
 //! that differ.
 Image tile_horizontally(const std::vector<Image>& images);

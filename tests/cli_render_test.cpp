@@ -190,6 +190,24 @@ TEST_F(CliRenderTest, LegendBandUnderThePicture) {
   EXPECT_NE(none.at(11, 300 - kLegendHeight + 14), img.at(11, 300 - kLegendHeight + 14));
 }
 
+// --video: an MP4 beside the picture, a frame every 1/30 s of nominal time from 0 and one at the
+// path's end (the bounds file's last waypoint time).
+TEST_F(CliRenderTest, VideoAlongThePathAtThirtyFramesPerSecond) {
+  if (std::system("command -v ffmpeg > /dev/null 2>&1") != 0) GTEST_SKIP() << "ffmpeg is not installed";
+  const std::string b = bounds_file();
+  const auto r = run_cli("render " + workcell("dallara") + " --bounds " + b + " --size 160x120 --video " +
+                         path("v.mp4") + " --out " + path("v.png"));
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const double duration = test::read_json(b).at("waypoints").back().at("t").get<double>();
+  int frames = 1;  // the end
+  for (int j = 0; j / 30.0 < duration - 1e-9; ++j) ++frames;
+  EXPECT_THAT(r.out, HasSubstr("(" + std::to_string(frames) + " frames at 30 fps"));
+  const std::string bytes = test::read_text(path("v.mp4"));
+  ASSERT_GT(bytes.size(), 1000u);
+  EXPECT_EQ(bytes.substr(4, 4), "ftyp");
+  EXPECT_EQ(png_size(path("v.png")), (std::array<int, 2>{160, 120}));
+}
+
 TEST(TileTest, SideBySideRowByRow) {
   Image a, b;
   a.width = 1;
@@ -251,6 +269,9 @@ TEST_F(CliRenderTest, BadInputExitsTwoAndWritesNothing) {
       {cell + " --out " + out + " --volume maybe", "--volume 'maybe' must be fade, on or off"},
       {cell + " --out " + out + " --frame nowhere", "--frame 'nowhere' must be robot or volume"},
       {cell + " --out " + out + " --legend maybe", "--legend 'maybe' must be on or off"},
+      {cell + " --out " + out + " --video " + path("v.avi"), "must end in .mp4"},
+      {cell + " --out " + out + " --video " + path("v.mp4") + " --size 161x120", "must be even"},
+      {workcell("dallara") + " --out " + out + " --video " + path("v.mp4"), "there is no path"},
       {workcell("dallara") + " --out " + out + " --strip 3",
        "--strip 3: there is no path without --bounds or --from/--to"},
       {cell + " --out " + out + " --strip 1", "--strip 1 must be within 2 .. 64"},

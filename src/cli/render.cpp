@@ -1,4 +1,5 @@
 #include "cli/render.hpp"
+#include "cli/video.hpp"
 
 #include <cmath>
 #include <iostream>
@@ -82,6 +83,9 @@ CLI::App* add_render(CLI::App& app, RenderArgs& args) {
   sub->add_option("--strip", args.strip,
                   "K frames at evenly spaced nominal times along the path, side by side in one image\n"
                   "(--size is the whole image; with --bounds or --from/--to)");
+  sub->add_option("--video", args.video,
+                  "Also write an MP4 of the path (30 frames per second of nominal time, the robot and its\n"
+                  "ghosts at each; needs ffmpeg; even --size)");
   sub->add_option(
          "--legend", args.legend,
          "A legend band under the picture (the volume's colour scale in metres, the ghosts' tints):\n"
@@ -248,9 +252,99 @@ void check_render_args(const RenderArgs& args) {
   if (args.strip != 0 && !with_path && args.bounds.empty())
     throw InputError("--strip " + std::to_string(args.strip) +
                      ": there is no path without --bounds or --from/--to");
+  if (!args.video.empty() && !with_path && args.bounds.empty())
+    throw InputError("--video " + args.video + ": there is no path without --bounds or --from/--to");
   if (args.strip != 0 && args.waypoint != -1)
     throw InputError("--strip shows the whole path: not with --waypoint " + std::to_string(args.waypoint));
   require_threads(args.threads);
+}
+
+// Draws frames: each rendered with the volume (faded around its robot with --volume fade), side by
+// side, the legend band under them.
+struct Painter {
+  const Scene& scene;
+  const RenderArgs& args;
+  const RenderInput& in;
+  const Params& params;
+  bool show_volume, legend;
+  int frame_height;
+  bool camera_given;
+  RenderCamera camera;     // --camera's angles and distance (when given)
+  Eigen::Vector3d lookat;  // --lookat (when given)
+
+  // The camera: --camera and --lookat where given, the default framing of `frames` elsewhere.
+  RenderCamera camera_for(const std::vector<Frame>& frames, int frame_width) const {
+    Eigen::AlignedBox3d robots;
+    for (const Frame& f : frames) {
+      std::vector<Eigen::VectorXd> shown = f.ghosts;
+      shown.push_back(f.q);
+      robots.extend(robot_extent(scene, shown));
+    }
+    const RenderCamera framed = default_camera(args, scene, params, in.volume, robots, frames.front().q,
+                                               static_cast<double>(frame_width) / frame_height);
+    RenderCamera c = camera;
+    if (!camera_given) c.distance = framed.distance;
+    c.lookat = args.lookat.empty() ? framed.lookat : lookat;
+    return c;
+  }
+
+  Image draw(const std::vector<Frame>& frames, const RenderCamera& c, int frame_width) const {
+    std::vector<Image> images;
+    for (const Frame& f : frames) {
+      RenderRequest request;
+      request.width = frame_width;
+      request.height = frame_height;
+      request.camera = c;
+      request.q = f.q;
+      request.ghosts = f.ghosts;
+      if (show_volume) request.volume = in.volume.boxes;
+      if (args.volume == "fade") {
+        std::vector<Eigen::VectorXd> shown = f.ghosts;
+        shown.push_back(f.q);
+        const Eigen::AlignedBox3d robot = robot_extent(scene, shown);
+        request.fade_region =
+            Eigen::AlignedBox3d(robot.min().array() - kFadeMargin, robot.max().array() + kFadeMargin);
+      }
+      images.push_back(render_scene(scene, request));
+    }
+    Image image = images.size() == 1 ? images.front() : tile_horizontally(images);
+    if (!legend) return image;
+    double max_top = 0;
+    if (show_volume)
+      for (const Box& b : in.volume.boxes) max_top = std::max(max_top, b.center.z() + b.half_size.z());
+    return stack_vertically(
+        {image, render_legend(image.width, max_top, !frames.front().ghosts.empty(), args.volume == "fade")});
+  }
+};
+
+// --video: the robot and its ghosts along the path at 30 frames per second of nominal time (and a
+// last frame at the path's end), one camera fitted to every frame. Without ffmpeg on PATH a
+// warning, and no video.
+void write_video(const Painter& painter, int width, GhostMode ghosts) {
+  const std::string ffmpeg = find_on_path("ffmpeg");
+  if (ffmpeg.empty()) {
+    std::cerr << "leeway: warning: --video " << painter.args.video
+              << ": ffmpeg is not on PATH (Debian: apt-get install ffmpeg); no video is written\n";
+    return;
+  }
+  const BoundsTrajectory path(painter.scene, painter.in.bounds);
+  std::vector<double> times;
+  for (long j = 0; static_cast<double>(j) / Mp4Stream::kFps < path.duration() - 1e-9; ++j)
+    times.push_back(static_cast<double>(j) / Mp4Stream::kFps);
+  times.push_back(path.duration());
+  std::vector<Frame> frames;
+  for (double t : times) {
+    const BoundsStage at = path.at_t(t);
+    frames.push_back(
+        Frame{at.nominal, ghost_configurations(WaypointBounds(at.nominal, at.lower, at.upper), ghosts)});
+  }
+  const RenderCamera camera = painter.camera_for(frames, width);
+  const int height = painter.frame_height + (painter.legend ? kLegendHeight : 0);
+  Mp4Stream stream(painter.args.video, "--video", width, height, ffmpeg);
+  for (const Frame& f : frames) stream.add(painter.draw({f}, camera, width));
+  const long written = stream.finish();
+  std::cout << "wrote " << painter.args.video << " (" << written << " frames at " << Mp4Stream::kFps
+            << " fps, " << format_number(path.duration()) << " s of nominal time)\n";
 }
 
 }  // namespace
@@ -259,7 +353,9 @@ int run_render(const RenderArgs& args) {
   // Every flag is checked before any work, so that bad input writes nothing.
   std::vector<std::string> inputs = model_input_files(args.cell);
   inputs.insert(inputs.end(), {args.bounds, args.params});
-  require_outputs({{args.out, "--out", {".png"}}}, inputs);
+  std::vector<OutputFile> outputs = {{args.out, "--out", {".png"}}};
+  if (!args.video.empty()) outputs.push_back({args.video, "--video", {".mp4"}});
+  require_outputs(outputs, inputs);
   const auto [width, height] = parse_size(args.size, "--size");
   const GhostMode ghosts = parse_ghosts(args.ghosts);
   const bool camera_given = !args.camera.empty();
@@ -271,6 +367,8 @@ int run_render(const RenderArgs& args) {
     lookat = v;
   }
   check_render_args(args);
+  if (!args.video.empty() && (width % 2 || height % 2))
+    throw InputError("--size " + args.size + ": a video's width and height must be even (H.264 in yuv420p)");
   const int frame_width = args.strip > 0 ? width / args.strip : width;
   const bool legend =
       args.legend == "on" && width >= kLegendMinWidth && height >= kLegendHeight + kLegendMinPicture;
@@ -294,53 +392,20 @@ int run_render(const RenderArgs& args) {
   const int k = args.waypoint == -1 ? n - 1 : args.waypoint;
   const std::vector<Frame> frames = render_frames(args, scene, in->bounds, k, ghosts);
 
-  Eigen::AlignedBox3d robots;
-  for (const Frame& f : frames) {
-    std::vector<Eigen::VectorXd> shown = f.ghosts;
-    shown.push_back(f.q);
-    robots.extend(robot_extent(scene, shown));
-  }
-  const RenderCamera framed = default_camera(args, scene, p, in->volume, robots, frames.front().q,
-                                             static_cast<double>(frame_width) / frame_height);
-  if (!camera_given) camera.distance = framed.distance;
-  camera.lookat = args.lookat.empty() ? framed.lookat : lookat;
-
-  std::vector<Image> images;
-  for (const Frame& f : frames) {
-    RenderRequest request;
-    request.width = frame_width;
-    request.height = frame_height;
-    request.camera = camera;
-    request.q = f.q;
-    request.ghosts = f.ghosts;
-    if (show_volume) request.volume = in->volume.boxes;
-    if (args.volume == "fade") {
-      std::vector<Eigen::VectorXd> shown = f.ghosts;
-      shown.push_back(f.q);
-      const Eigen::AlignedBox3d robot = robot_extent(scene, shown);
-      request.fade_region =
-          Eigen::AlignedBox3d(robot.min().array() - kFadeMargin, robot.max().array() + kFadeMargin);
-    }
-    images.push_back(render_scene(scene, request));
-  }
-  Image image = images.size() == 1 ? images.front() : tile_horizontally(images);
-  if (legend) {
-    double max_top = 0;
-    if (show_volume)
-      for (const Box& b : in->volume.boxes) max_top = std::max(max_top, b.center.z() + b.half_size.z());
-    image = stack_vertically(
-        {image, render_legend(image.width, max_top, !frames.front().ghosts.empty(), args.volume == "fade")});
-  }
+  const Painter painter{scene, args, *in, p, show_volume, legend, frame_height, camera_given, camera, lookat};
+  const RenderCamera used = painter.camera_for(frames, frame_width);
+  const Image image = painter.draw(frames, used, frame_width);
   write_png(args.out, image);
   const std::string shown = n == 0           ? "no bounds"
                             : args.strip > 0 ? std::to_string(args.strip) + " frames along " + in->what
                                              : "waypoint " + std::to_string(k) + " of " + in->what;
   std::cout << "wrote " << args.out << " (" << image.width << "x" << image.height << " pixels; " << shown
             << ", " << (show_volume ? in->volume.boxes.size() : 0) << " volume boxes, "
-            << frames.front().ghosts.size() << " ghosts; camera " << format_number(camera.azimuth) << ","
-            << format_number(camera.elevation) << "," << format_number(camera.distance)
-            << " [rad, rad, m], look-at " << format_number(camera.lookat.x()) << ","
-            << format_number(camera.lookat.y()) << "," << format_number(camera.lookat.z()) << " [m])\n";
+            << frames.front().ghosts.size() << " ghosts; camera " << format_number(used.azimuth) << ","
+            << format_number(used.elevation) << "," << format_number(used.distance)
+            << " [rad, rad, m], look-at " << format_number(used.lookat.x()) << ","
+            << format_number(used.lookat.y()) << "," << format_number(used.lookat.z()) << " [m])\n";
+  if (!args.video.empty()) write_video(painter, width, ghosts);
   return kExitOk;
 }
 

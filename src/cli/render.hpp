@@ -18,6 +18,7 @@ struct RenderArgs {
   int waypoint = -1;                //!< waypoint shown; -1: the last
   int strip = 0;                    //!< frames along the path side by side; 0: one picture
   std::string legend = "on";        //!< legend band under the picture: on or off
+  std::string video;                //!< also an MP4 along the path ("": none)
   std::string camera;               //!< "az,el,dist" [rad, rad, m]; empty: framing the reach circle
   std::string lookat;               //!< "x,y,z" [m]; empty: the reach circle's centre
   std::string size = "1280x960";    //!< image size [pixels]

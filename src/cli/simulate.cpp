@@ -1,4 +1,5 @@
 #include "cli/simulate.hpp"
+#include "cli/video.hpp"
 
 #include <unistd.h>
 
@@ -104,35 +105,13 @@ HumanOptions human_options(const SimulateArgs& args) {
   return h;
 }
 
-// The path of an executable `name` on PATH, or "".
-std::string find_on_path(const std::string& name) {
-  const char* path = std::getenv("PATH");
-  std::string dirs = path ? path : "";
-  size_t start = 0;
-  while (start <= dirs.size()) {
-    const size_t end = dirs.find(':', start);
-    const std::string dir = dirs.substr(start, end == std::string::npos ? std::string::npos : end - start);
-    const std::string candidate = (dir.empty() ? "." : dir) + "/" + name;
-    if (::access(candidate.c_str(), X_OK) == 0) return candidate;
-    if (end == std::string::npos) break;
-    start = end + 1;
-  }
-  return "";
-}
-
-std::string shell_quote(const std::string& text) {
-  std::string out = "'";
-  for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
 // Frames at 30 fps of simulated time, piped as raw RGB into ffmpeg, which writes an H.264 MP4 into
 // a temporary file renamed over the target when it succeeds.
 class VideoWriter {
  public:
   VideoWriter(const Scene& scene, const BoundsTrajectory& bounds, const std::string& path, int width,
               int height, const std::string& ffmpeg)
-      : scene_(scene), temp_(path), width_(width), height_(height) {
+      : scene_(scene), stream_(path, "--video", width, height, ffmpeg) {
     // The camera frames the tool's reach along the path: around the first hinge's anchor, out to
     // the farthest nominal tool position plus 1 m.
     DataPtr d = make_data(scene.model());
@@ -157,21 +136,12 @@ class VideoWriter {
     RenderCamera camera = frame_circle(base, radius, 2.5, fovy);
     camera.elevation = -0.45;  // lower than a still picture's: the push is mostly level or down
     renderer_ = std::make_unique<FrameRenderer>(scene, width, height, camera);
-    const std::string command =
-        shell_quote(ffmpeg) + " -hide_banner -loglevel error -y -f rawvideo -pix_fmt rgb24 -s " +
-        std::to_string(width) + "x" + std::to_string(height) +
-        " -r 30 -i - -an -c:v libx264 -pix_fmt yuv420p -f mp4 " + shell_quote(temp_.path());
-    pipe_ = ::popen(command.c_str(), "w");
-    if (!pipe_) throw InputError("--video: could not start " + ffmpeg);
-  }
-  ~VideoWriter() {
-    if (pipe_) ::pclose(pipe_);
   }
 
   // Called at every control period: renders a frame whenever 1/30 s of simulated time has passed.
   void on_frame(const mjModel& m, const mjData& d, const SimFrame& f) {
-    if (failed_ || f.t + 1e-9 < next_) return;
-    next_ += 1.0 / 30;
+    if (f.t + 1e-9 < next_) return;
+    next_ += 1.0 / Mp4Stream::kFps;
     Eigen::VectorXd q(scene_.dof());
     for (int j = 0; j < scene_.dof(); ++j)
       q[j] = d.qpos[m.jnt_qposadr[scene_.joints()[static_cast<size_t>(j)].id]];
@@ -179,30 +149,17 @@ class VideoWriter {
     // The push as an arrow at the tool, 1 cm per newton.
     const Image image =
         renderer_->render(q, ghost_configurations(box, GhostMode::kCorners), f.tool, 0.01 * f.force);
-    if (std::fwrite(image.rgb.data(), 1, image.rgb.size(), pipe_) != image.rgb.size()) failed_ = true;
-    ++frames_;
+    stream_.add(image);
   }
 
   // Ends the stream; returns the frame count. @throws InputError when ffmpeg failed.
-  long finish(const std::string& path) {
-    const int status = ::pclose(pipe_);
-    pipe_ = nullptr;
-    if (failed_ || status != 0)
-      throw InputError("--video " + path + ": ffmpeg failed (exit status " + std::to_string(status) +
-                       "); no video written");
-    temp_.commit();
-    return frames_;
-  }
+  long finish() { return stream_.finish(); }
 
  private:
   const Scene& scene_;
-  TempFile temp_;
-  int width_, height_;
+  Mp4Stream stream_;
   std::unique_ptr<FrameRenderer> renderer_;
-  FILE* pipe_ = nullptr;
   double next_ = 0;
-  long frames_ = 0;
-  bool failed_ = false;
 };
 
 void print_report(const Scene& scene, const SimulationReport& r, const SimulateOptions& o) {
@@ -283,7 +240,7 @@ int run_simulate(const SimulateArgs& args) {
   if (!args.video.empty()) {
     j["video"] = nullptr;
     if (video) {
-      const long frames = video->finish(args.video);
+      const long frames = video->finish();
       j["video"] = {{"path", args.video}, {"frames", frames}, {"fps", 30}};
     }
   }

@@ -120,22 +120,32 @@ class RenderTest : public test::MujocoTest {
   Scene scene() {
     return Scene::load(dir_.write("one_link.xml", test::one_link_cell("", R"(<key name="home" qpos="0"/>)")));
   }
+  // The arm at 0 seen from 8 m almost straight above the origin, 160 x 120 pixels.
+  static RenderRequest top_down() {
+    RenderRequest r;
+    r.width = 160;
+    r.height = 120;
+    r.q = Eigen::VectorXd::Zero(1);
+    r.camera.azimuth = 0;
+    r.camera.elevation = -1.5;
+    r.camera.distance = 8;
+    r.camera.lookat = Eigen::Vector3d::Zero();
+    return r;
+  }
+  // A box on the floor away from the arm, which lies along +x.
+  static Box beside_the_arm() {
+    Box box;
+    box.center = {-1.5, 1.5, 0.25};
+    box.half_size = {0.4, 0.4, 0.25};
+    return box;
+  }
   test::TempDir dir_;
 };
 
 TEST_F(RenderTest, VolumeBoxColoursThePixelItProjectsTo) {
   const Scene s = scene();
-  RenderRequest r;
-  r.width = 160;
-  r.height = 120;
-  r.q = Eigen::VectorXd::Zero(1);
-  r.camera.azimuth = 0;
-  r.camera.elevation = -1.5;
-  r.camera.distance = 8;
-  r.camera.lookat = Eigen::Vector3d::Zero();
-  Box box;
-  box.center = {-1.5, 1.5, 0.25};  // away from the arm, which lies along +x
-  box.half_size = {0.4, 0.4, 0.25};
+  RenderRequest r = top_down();
+  const Box box = beside_the_arm();
   const Image off = render_scene(s, r);
   r.volume = {box};
   const Image on = render_scene(s, r);
@@ -242,17 +252,8 @@ TEST_F(RenderTest, TurningTheFramedArmChangesManyPixels) {
 // the faded opacity; one that does neither at the normal one.
 TEST_F(RenderTest, VolumeBoxesAroundTheRobotAreFaded) {
   const Scene s = scene();
-  RenderRequest r;
-  r.width = 160;
-  r.height = 120;
-  r.q = Eigen::VectorXd::Zero(1);
-  r.camera.azimuth = 0;
-  r.camera.elevation = -1.5;
-  r.camera.distance = 8;
-  r.camera.lookat = Eigen::Vector3d::Zero();
-  Box box;
-  box.center = {-1.5, 1.5, 0.25};
-  box.half_size = {0.4, 0.4, 0.25};
+  RenderRequest r = top_down();
+  const Box box = beside_the_arm();
   r.volume = {box};
   const Image normal = render_scene(s, r);
   r.fade_region = Eigen::AlignedBox3d(Eigen::Vector3d(-2, 1, 0), Eigen::Vector3d(-1, 2, 1));

@@ -187,7 +187,21 @@ std::optional<RenderInput> render_input(const RenderArgs& args, const Scene& sce
 struct Frame {
   Eigen::VectorXd q;
   std::vector<Eigen::VectorXd> ghosts;
+  Eigen::AlignedBox3d robot;  // the robot's extent at q and at the ghosts [m]
 };
+
+Frame make_frame(const Scene& scene, Eigen::VectorXd q, std::vector<Eigen::VectorXd> ghosts) {
+  std::vector<Eigen::VectorXd> shown = ghosts;
+  shown.push_back(q);
+  const Eigen::AlignedBox3d robot = robot_extent(scene, shown);
+  return Frame{std::move(q), std::move(ghosts), robot};
+}
+
+// The frame at one point of the path: the nominal configuration and the ghosts of the box there.
+Frame stage_frame(const Scene& scene, const BoundsStage& at, GhostMode ghosts) {
+  return make_frame(scene, at.nominal,
+                    ghost_configurations(WaypointBounds(at.nominal, at.lower, at.upper), ghosts));
+}
 
 // The frames shown: the bare cell's keyframe, waypoint k, or (--strip K) K boxes at evenly spaced
 // nominal times along the path (BoundsTrajectory: linear in the path parameter between waypoints).
@@ -197,18 +211,15 @@ std::vector<Frame> render_frames(const RenderArgs& args, const Scene& scene,
     const Eigen::VectorXd q = !args.key.empty()            ? scene.keyframe(args.key).q
                               : !scene.keyframes().empty() ? scene.keyframes().front().q
                                                            : Eigen::VectorXd::Zero(scene.dof());
-    return {Frame{q, {}}};
+    return {make_frame(scene, q, {})};
   }
   if (args.strip == 0)
-    return {Frame{bounds[static_cast<size_t>(k)].q,
-                  ghost_configurations(bounds[static_cast<size_t>(k)], ghosts)}};
+    return {make_frame(scene, bounds[static_cast<size_t>(k)].q,
+                       ghost_configurations(bounds[static_cast<size_t>(k)], ghosts))};
   const BoundsTrajectory path(scene, bounds);
   std::vector<Frame> out;
-  for (int j = 0; j < args.strip; ++j) {
-    const BoundsStage at = path.at_t(path.duration() * j / (args.strip - 1));
-    out.push_back(
-        Frame{at.nominal, ghost_configurations(WaypointBounds(at.nominal, at.lower, at.upper), ghosts)});
-  }
+  for (int j = 0; j < args.strip; ++j)
+    out.push_back(stage_frame(scene, path.at_t(path.duration() * j / (args.strip - 1)), ghosts));
   return out;
 }
 
@@ -223,8 +234,7 @@ RenderCamera default_camera(const RenderArgs& args, const Scene& scene, const Pa
   if (volume.grid.rows > 0) {
     const Grid& g = volume.grid;
     const Eigen::Vector2d centre(g.origin_x + 0.5 * g.rows * g.side, g.origin_y + 0.5 * g.cols * g.side);
-    double top = kRobotHeight;
-    for (const Box& b : volume.boxes) top = std::max(top, b.center.z() + b.half_size.z());
+    const double top = std::max(kRobotHeight, highest_top(volume.boxes));
     return frame_circle(centre, 0.5 * std::max(g.rows, g.cols) * g.side, top, fovy);
   }
   return frame_circle(arm_base(scene, q), p.volume.reach_radius, kRobotHeight, fovy);
@@ -275,11 +285,7 @@ struct Painter {
   // The camera: --camera and --lookat where given, the default framing of `frames` elsewhere.
   RenderCamera camera_for(const std::vector<Frame>& frames, int frame_width) const {
     Eigen::AlignedBox3d robots;
-    for (const Frame& f : frames) {
-      std::vector<Eigen::VectorXd> shown = f.ghosts;
-      shown.push_back(f.q);
-      robots.extend(robot_extent(scene, shown));
-    }
+    for (const Frame& f : frames) robots.extend(f.robot);
     const RenderCamera framed = default_camera(args, scene, params, in.volume, robots, frames.front().q,
                                                static_cast<double>(frame_width) / frame_height);
     RenderCamera c = camera;
@@ -298,20 +304,14 @@ struct Painter {
       request.q = f.q;
       request.ghosts = f.ghosts;
       if (show_volume) request.volume = in.volume.boxes;
-      if (args.volume == "fade") {
-        std::vector<Eigen::VectorXd> shown = f.ghosts;
-        shown.push_back(f.q);
-        const Eigen::AlignedBox3d robot = robot_extent(scene, shown);
+      if (args.volume == "fade")
         request.fade_region =
-            Eigen::AlignedBox3d(robot.min().array() - kFadeMargin, robot.max().array() + kFadeMargin);
-      }
+            Eigen::AlignedBox3d(f.robot.min().array() - kFadeMargin, f.robot.max().array() + kFadeMargin);
       images.push_back(render_scene(scene, request));
     }
     Image image = images.size() == 1 ? images.front() : tile_horizontally(images);
     if (!legend) return image;
-    double max_top = 0;
-    if (show_volume)
-      for (const Box& b : in.volume.boxes) max_top = std::max(max_top, b.center.z() + b.half_size.z());
+    const double max_top = show_volume ? highest_top(in.volume.boxes) : 0.0;
     return stack_vertically(
         {image, render_legend(image.width, max_top, !frames.front().ghosts.empty(), args.volume == "fade")});
   }
@@ -333,11 +333,7 @@ void write_video(const Painter& painter, int width, GhostMode ghosts) {
     times.push_back(static_cast<double>(j) / Mp4Stream::kFps);
   times.push_back(path.duration());
   std::vector<Frame> frames;
-  for (double t : times) {
-    const BoundsStage at = path.at_t(t);
-    frames.push_back(
-        Frame{at.nominal, ghost_configurations(WaypointBounds(at.nominal, at.lower, at.upper), ghosts)});
-  }
+  for (double t : times) frames.push_back(stage_frame(painter.scene, path.at_t(t), ghosts));
   const RenderCamera camera = painter.camera_for(frames, width);
   const int height = painter.frame_height + (painter.legend ? kLegendHeight : 0);
   Mp4Stream stream(painter.args.video, "--video", width, height, ffmpeg);

@@ -133,8 +133,7 @@ std::string number(double v) {
 }
 
 std::string volume_body(const std::vector<Box>& boxes) {
-  double max_top = 0;
-  for (const Box& b : boxes) max_top = std::max(max_top, b.center.z() + b.half_size.z());
+  const double max_top = highest_top(boxes);
   std::string out = std::string("\n    <!-- leeway: the generated volume, ") + std::to_string(boxes.size()) +
                     " boxes [m], visual only, coloured by the height of their top -->\n    <body name=\"" +
                     kExportBodyName + "\">\n";

@@ -88,6 +88,11 @@ Image OffscreenContext::read() const {
 
 namespace {
 
+// The ghosts' tints (RGB): every joint at its lower bound bluish, at its upper bound reddish. The
+// legend shows the same.
+constexpr float kLowerGhostTint[3] = {0.35f, 0.60f, 0.95f};
+constexpr float kUpperGhostTint[3] = {0.95f, 0.35f, 0.35f};
+
 constexpr double kPi = 3.14159265358979323846;
 
 void put_u32(std::string& out, unsigned long v) {
@@ -296,18 +301,18 @@ Image render_legend(int width, double max_top, bool ghosts, bool faded) {
     d.label(x, 48, "volume box top [m]", 9);
     x += bar + 24;
   }
+  const double after_scale = x;
   auto swatch = [&](const detail::Rgb& c, const std::string& text) {
     d.rect(x, 8, 14, 12, c, {0.3, 0.3, 0.3}, 1);
     d.label(x + 20, 18, text, 9);
     x += 26 + detail::text_width(text, 9);
   };
   if (ghosts) {
-    swatch({0.35, 0.60, 0.95}, "ghost: joints at lower bound");
-    swatch({0.95, 0.35, 0.35}, "ghost: joints at upper bound");
+    auto rgb = [](const float(&t)[3]) { return detail::Rgb{t[0], t[1], t[2]}; };
+    swatch(rgb(kLowerGhostTint), "ghost: joints at lower bound");
+    swatch(rgb(kUpperGhostTint), "ghost: joints at upper bound");
   }
-  if (faded)
-    d.label(max_top > 0 ? 10 + std::min(240.0, 0.4 * width) + 24 : 10, 44,
-            "boxes around and in front of the robot faded", 9);
+  if (faded) d.label(after_scale, 44, "boxes around and in front of the robot faded", 9);
   return detail::to_image(d);
 }
 
@@ -346,6 +351,12 @@ Image tile_horizontally(const std::vector<Image>& images) {
     }
   }
   return out;
+}
+
+double highest_top(const std::vector<Box>& boxes) {
+  double top = 0;
+  for (const Box& b : boxes) top = std::max(top, b.center.z() + b.half_size.z());
+  return top;
 }
 
 std::array<float, 3> height_colour(double top, double max_top) {
@@ -415,9 +426,8 @@ void add_ghost(const mjModel& m, mjData& d, mjvOption& opt, const Eigen::Vector3
       geom.rgba[3] = 0;
       continue;
     }
-    geom.rgba[0] = lower ? 0.35f : 0.95f;
-    geom.rgba[1] = lower ? 0.60f : 0.35f;
-    geom.rgba[2] = lower ? 0.95f : 0.35f;
+    const float* tint = lower ? kLowerGhostTint : kUpperGhostTint;
+    for (int c = 0; c < 3; ++c) geom.rgba[c] = tint[c];
     geom.rgba[3] = 0.28f;
     geom.segid = -1;
     mark_transparent(geom, campos);
@@ -544,8 +554,7 @@ Image render_scene(const Scene& scene, const RenderRequest& request) {
 
   // The volume: one box per volume box, coloured by the height of its top.
   const FadeTest fade(request, m.vis.global.fovy * kPi / 180);
-  double max_top = 0;
-  for (const Box& b : request.volume) max_top = std::max(max_top, b.center.z() + b.half_size.z());
+  const double max_top = highest_top(request.volume);
   for (const Box& b : request.volume) {
     if (scn.ngeom >= scn.maxgeom) break;  // cannot happen: maxgeom counts every box
     mjtNum size[3], pos[3], mat[9];

@@ -105,6 +105,9 @@ struct RenderRequest {
   double faded_alpha = 0.08;
 };
 
+//! The height of the highest box's top [m] (its centre plus its half height); 0 for no box.
+double highest_top(const std::vector<Box>& boxes);
+
 //! Colour of a volume box whose top is at `top` [m], on a blue-green-yellow scale (viridis-like)
 //! from 0 to `max_top` [m]; alpha is set by the caller.
 std::array<float, 3> height_colour(double top, double max_top);

@@ -10,6 +10,8 @@
 # locales: the locale sources from which the plot test compiles a decimal-comma locale (de_DE)
 # with localedef when none is installed.
 # ffmpeg: `leeway simulate --video` pipes its frames to it (optional: without it no video is written).
+# libjs-three: three.js, which `leeway view` inlines into its page; chromium: the browser the viewer's
+# tests open the page in, headless (optional: without it those tests are skipped).
 # `--sanitizers` adds what scripts/sanitize.sh needs: clang and its sanitizer/libFuzzer runtimes
 # (gcc's ASan/UBSan/TSan runtimes come with build-essential).
 set -euo pipefail
@@ -19,7 +21,7 @@ packages=(
   libmujoco-dev libqhull-dev libeigen3-dev libompl-dev libnlopt-cxx-dev liburdfdom-dev
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
   libosmesa6-dev zlib1g-dev libopenmpi-dev openmpi-bin
-  pybind11-dev python3-dev python3-numpy python3-pytest ffmpeg locales
+  pybind11-dev python3-dev python3-numpy python3-pytest ffmpeg locales libjs-three chromium
 )
 for arg in "$@"; do
   case "$arg" in

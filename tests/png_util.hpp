@@ -3,10 +3,12 @@
 
 #include <zlib.h>
 
+#include <cstdlib>
 #include <fstream>
 #include <iterator>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "leeway/viz/render.hpp"
 
@@ -47,6 +49,69 @@ inline Image decode_png(const std::string& bytes) {
     if (raw[start] != '\0') throw std::runtime_error("a row filter other than 0");
     image.rgb.insert(image.rgb.end(), raw.begin() + static_cast<long>(start + 1),
                      raw.begin() + static_cast<long>(start + 1 + row));
+  }
+  return image;
+}
+
+//! Decodes an 8-bit RGB or RGBA PNG without interlace, any row filter (what browsers write for a
+//! screenshot); the alpha channel is dropped. Throws std::runtime_error on anything else.
+inline Image decode_browser_png(const std::string& bytes) {
+  if (bytes.compare(0, 8, std::string("\x89PNG\r\n\x1a\n", 8)) != 0)
+    throw std::runtime_error("no PNG signature");
+  auto u32 = [&bytes](size_t at) {
+    unsigned v = 0;
+    for (size_t k = 0; k < 4; ++k) v = (v << 8) | static_cast<unsigned char>(bytes.at(at + k));
+    return v;
+  };
+  Image image;
+  int channels = 0;
+  std::string packed;
+  for (size_t at = 8; at + 8 <= bytes.size();) {
+    const size_t len = u32(at);
+    const std::string type = bytes.substr(at + 4, 4);
+    if (type == "IHDR") {
+      image.width = static_cast<int>(u32(at + 8));
+      image.height = static_cast<int>(u32(at + 12));
+      const int depth = bytes.at(at + 16), colour = bytes.at(at + 17), interlace = bytes.at(at + 20);
+      channels = colour == 2 ? 3 : colour == 6 ? 4 : 0;
+      if (depth != 8 || channels == 0 || interlace != 0)
+        throw std::runtime_error("not 8-bit RGB(A) without interlace");
+    }
+    if (type == "IDAT") packed += bytes.substr(at + 8, len);
+    at += 12 + len;
+  }
+  const size_t row = static_cast<size_t>(channels) * static_cast<size_t>(image.width);
+  std::string raw((row + 1) * static_cast<size_t>(image.height), '\0');
+  uLongf size = static_cast<uLongf>(raw.size());
+  if (uncompress(reinterpret_cast<Bytef*>(raw.data()), &size, reinterpret_cast<const Bytef*>(packed.data()),
+                 static_cast<uLong>(packed.size())) != Z_OK ||
+      size != raw.size())
+    throw std::runtime_error("IDAT does not inflate to the image size");
+  std::vector<unsigned char> prior(row, 0), line(row);
+  const size_t bpp = static_cast<size_t>(channels);
+  for (int y = 0; y < image.height; ++y) {
+    const size_t start = (row + 1) * static_cast<size_t>(y);
+    const int filter = static_cast<unsigned char>(raw[start]);
+    for (size_t i = 0; i < row; ++i) {
+      const int x = static_cast<unsigned char>(raw[start + 1 + i]);
+      const int a = i >= bpp ? line[i - bpp] : 0, b = prior[i], c = i >= bpp ? prior[i - bpp] : 0;
+      int predicted = 0;
+      if (filter == 1)
+        predicted = a;
+      else if (filter == 2)
+        predicted = b;
+      else if (filter == 3)
+        predicted = (a + b) / 2;
+      else if (filter == 4) {
+        const int p = a + b - c, pa = std::abs(p - a), pb = std::abs(p - b), pc = std::abs(p - c);
+        predicted = pa <= pb && pa <= pc ? a : pb <= pc ? b : c;
+      } else if (filter != 0)
+        throw std::runtime_error("unknown row filter");
+      line[i] = static_cast<unsigned char>((x + predicted) & 0xff);
+    }
+    for (int px = 0; px < image.width; ++px)
+      for (int k = 0; k < 3; ++k) image.rgb.push_back(line[static_cast<size_t>(px * channels + k)]);
+    prior = line;
   }
   return image;
 }

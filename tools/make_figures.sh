@@ -3,6 +3,8 @@
 #   - docs/images/dallara-home-patch-volume.png: `leeway render` of the Dallara cell at the patch with
 #     its volume and the ghosts of the robot at its bounds (the README's first picture);
 #   - docs/images/dallara-home-patch-bounds.svg: `leeway plot` of the same bounds file;
+#   - docs/images/dallara-home-patch-view.png: `leeway view` of the same bounds file, its page
+#     opened in headless Chromium at t = 0.5 s (needs chromium);
 #   - docs/images/dallara-patch-mould-simulate.png: a frame of `leeway simulate --video` on the
 #     Dallara patch-mould path with a random push (needs ffmpeg);
 #   - docs/images/sweep-CELL-PATH.svg: `leeway plot` of the nine recorded sweeps in
@@ -21,6 +23,12 @@ bounds=docs/data/figures/dallara-home-patch.json
 "$leeway" bounds "$cell" --from home --to patch --out "$bounds" > /dev/null
 "$leeway" render "$cell" --bounds "$bounds" --size 960x720 --out docs/images/dallara-home-patch-volume.png
 "$leeway" plot "$bounds" --out docs/images/dallara-home-patch-bounds.svg
+view_dir=$(mktemp -d)
+"$leeway" view "$cell" --bounds "$bounds" --out "$view_dir/view.html" > /dev/null
+chromium --headless --no-sandbox --use-angle=swiftshader --enable-unsafe-swiftshader --hide-scrollbars \
+  --no-first-run --user-data-dir="$view_dir/profile" --window-size=1280,880 \
+  --screenshot=docs/images/dallara-home-patch-view.png "file://$view_dir/view.html?t=0.5" 2> /dev/null
+rm -rf "$view_dir"
 
 # The closed loop (docs/simulate.md): the frame at t = 3 s of the video of a random push (seed 1).
 sim_bounds=docs/data/figures/dallara-patch-mould.json

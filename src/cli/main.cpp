@@ -25,6 +25,7 @@
 #include "cli/sample.hpp"
 #include "cli/simulate.hpp"
 #include "cli/sweep.hpp"
+#include "cli/view.hpp"
 #include "leeway/core/error.hpp"
 #include "leeway/core/file_io.hpp"
 #include "leeway/core/mujoco_util.hpp"
@@ -51,6 +52,7 @@ int main(int argc, char** argv) {
   ImportUrdfArgs import_urdf;
   NewCellArgs new_cell;
   RenderArgs render;
+  ViewArgs view;
   PlotArgs plot;
   BatchArgs batch;
   SimulateArgs simulate;
@@ -69,6 +71,7 @@ int main(int argc, char** argv) {
       {add_import_urdf(app, import_urdf), [&] { return run_import_urdf(import_urdf); }},
       {add_new_cell(app, new_cell), [&] { return run_new_cell(new_cell); }},
       {add_render(app, render), [&] { return run_render(render); }},
+      {add_view(app, view), [&] { return run_view(view); }},
       {add_plot(app, plot), [&] { return run_plot(plot); }},
       {add_batch(app, batch), [&] { return run_batch(batch); }},
   };

@@ -5,6 +5,7 @@
 #include <iostream>
 #include <optional>
 
+#include "core/json_io.hpp"
 #include "leeway/core/bounds_trajectory.hpp"
 #include "leeway/core/file_io.hpp"
 #include "leeway/core/mjcf_source.hpp"
@@ -39,6 +40,51 @@ Eigen::Vector2d arm_base(const Scene& scene, const Eigen::VectorXd& q) {
 }
 
 }  // namespace
+
+std::optional<RenderInput> render_input(const RenderArgs& args, const Scene& scene, Params& p,
+                                        bool show_volume) {
+  RenderInput in;
+  if (!args.bounds.empty()) {
+    BoundsFileVolume file = read_bounds_volume(args.bounds, scene, /*require_volume=*/show_volume);
+    in.bounds = std::move(file.bounds);
+    in.volume = std::move(file.volume);
+    p = file.params;
+    in.what = args.bounds;
+    in.trajectory.emplace(read_bounds_trajectory(args.bounds, scene));
+    const nlohmann::json safety =
+        detail::read_json_file(args.bounds, "bounds file").value("safety", nlohmann::json::object());
+    in.safety_mode = safety.value("mode", std::string("none"));
+    in.proven = safety.value("certified", false);
+    in.margin = safety.value("margin", 0.0);
+  } else if (!args.from.empty()) {
+    if (args.waypoints < 2)
+      throw InputError("--waypoints " + std::to_string(args.waypoints) + " must be >= 2");
+    require_memory(args.waypoints * kBytesPerWaypoint, "--waypoints " + std::to_string(args.waypoints));
+    // As leeway bounds: a colliding straight path is planned around (default planner options).
+    PathRequest request;
+    request.from = args.from;
+    request.to = args.to;
+    request.waypoints = args.waypoints;
+    request.plan_around = !args.no_plan;
+    const NominalPath path = resolve_nominal_path(scene, request);
+    if (!report_refusal(path)) return std::nullopt;
+    if (!path.replaced.empty()) std::cout << path.replaced << "\n";
+    const int n = static_cast<int>(path.waypoints.size());
+    if (args.waypoint >= n)
+      throw InputError("--waypoint " + std::to_string(args.waypoint) + ": the path has " + std::to_string(n) +
+                       " waypoints (0 .. " + std::to_string(n - 1) + ")");
+    VolumeModel world(scene, VolumeModel::capacity_for(scene, p.height_map.max_cells));
+    BoundsRun run = compute_bounds(scene, world, path.waypoints, p, args.threads);
+    in.bounds = std::move(run.bounds);
+    in.volume = std::move(run.volume);
+    in.what = path.label;
+    in.trajectory.emplace(scene, in.bounds);
+    in.safety_mode = safety_mode_name(run.safety.mode);
+    in.proven = run.safety.mode == SafetyMode::kCertified && run.safety.all_passed;
+    in.margin = p.safety.margin;
+  }
+  return in;
+}
 
 CLI::App* add_render(CLI::App& app, RenderArgs& args) {
   CLI::App* sub = app.add_subcommand(
@@ -139,49 +185,6 @@ RenderCamera parse_camera(const std::string& text) {
 }  // namespace
 
 namespace {
-
-// The bounds (from the file, or computed on the nominal path as leeway bounds does) and their
-// volume; nullopt when the path was refused (already reported).
-struct RenderInput {
-  std::vector<WaypointBounds> bounds;
-  Volume volume;
-  std::string what;  // the file, or the path's label
-};
-
-std::optional<RenderInput> render_input(const RenderArgs& args, const Scene& scene, Params& p,
-                                        bool show_volume) {
-  RenderInput in;
-  if (!args.bounds.empty()) {
-    BoundsFileVolume file = read_bounds_volume(args.bounds, scene, /*require_volume=*/show_volume);
-    in.bounds = std::move(file.bounds);
-    in.volume = std::move(file.volume);
-    p = file.params;
-    in.what = args.bounds;
-  } else if (!args.from.empty()) {
-    if (args.waypoints < 2)
-      throw InputError("--waypoints " + std::to_string(args.waypoints) + " must be >= 2");
-    require_memory(args.waypoints * kBytesPerWaypoint, "--waypoints " + std::to_string(args.waypoints));
-    // As leeway bounds: a colliding straight path is planned around (default planner options).
-    PathRequest request;
-    request.from = args.from;
-    request.to = args.to;
-    request.waypoints = args.waypoints;
-    request.plan_around = !args.no_plan;
-    const NominalPath path = resolve_nominal_path(scene, request);
-    if (!report_refusal(path)) return std::nullopt;
-    if (!path.replaced.empty()) std::cout << path.replaced << "\n";
-    const int n = static_cast<int>(path.waypoints.size());
-    if (args.waypoint >= n)
-      throw InputError("--waypoint " + std::to_string(args.waypoint) + ": the path has " + std::to_string(n) +
-                       " waypoints (0 .. " + std::to_string(n - 1) + ")");
-    VolumeModel world(scene, VolumeModel::capacity_for(scene, p.height_map.max_cells));
-    BoundsRun run = compute_bounds(scene, world, path.waypoints, p, args.threads);
-    in.bounds = std::move(run.bounds);
-    in.volume = std::move(run.volume);
-    in.what = path.label;
-  }
-  return in;
-}
 
 // One picture: the robot at q and its ghosts.
 struct Frame {

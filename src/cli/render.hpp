@@ -2,9 +2,16 @@
 // `leeway render`: an offscreen picture of the cell, the robot at a waypoint, the volume and ghosts.
 
 #include <CLI/CLI.hpp>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "cli/common.hpp"
+#include "leeway/core/bounds.hpp"
+#include "leeway/core/bounds_trajectory.hpp"
+#include "leeway/core/params.hpp"
+#include "leeway/core/scene.hpp"
+#include "leeway/core/volume.hpp"
 
 namespace leeway::cli {
 
@@ -35,6 +42,24 @@ struct RenderArgs {
   bool no_plan = false;             //!< refuse a colliding straight path instead of planning around it
   int threads = default_threads();  //!< worker threads
 };
+
+//! What a picture or the viewer shows: the bounds (from the file, or computed on the nominal path as
+//! leeway bounds does), their volume, timing and safety record; no bounds for a bare cell.
+struct RenderInput {
+  std::vector<WaypointBounds> bounds;
+  Volume volume;
+  std::string what;                            //!< the file, or the path's label
+  std::optional<BoundsTrajectory> trajectory;  //!< the bounds in time (the file's times)
+  std::string safety_mode = "none";            //!< certified, sampled or none
+  bool proven = false;                         //!< certified, every segment passed
+  double margin = 0.0;                         //!< the certified clearance [m]
+};
+
+//! The bounds `args` asks for (--bounds, or --from/--to computed as leeway bounds does) with their
+//! volume; `p` becomes the file's parameters. nullopt when the path was refused (already reported).
+//! @throws InputError on a bounds file for another cell, a bad path or waypoint count.
+std::optional<RenderInput> render_input(const RenderArgs& args, const Scene& scene, Params& p,
+                                        bool show_volume);
 
 //! Adds the `render` subcommand, parsing into `args`; returns it.
 CLI::App* add_render(CLI::App& app, RenderArgs& args);

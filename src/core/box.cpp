@@ -160,4 +160,9 @@ Box geom_box(const mjModel& m, const mjData& d, int geom) {
 
 bool has_bounding_box(const mjModel& m, int geom) { return m.geom_type[geom] != mjGEOM_PLANE; }
 
+Eigen::AlignedBox3d aligned(const Box& b) {
+  const Eigen::Vector3d reach = b.rotation.cwiseAbs() * b.half_size;
+  return Eigen::AlignedBox3d(b.center - reach, b.center + reach);
+}
+
 }  // namespace leeway

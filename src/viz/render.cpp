@@ -88,11 +88,6 @@ Image OffscreenContext::read() const {
 
 namespace {
 
-// The ghosts' tints (RGB): every joint at its lower bound bluish, at its upper bound reddish. The
-// legend shows the same.
-constexpr float kLowerGhostTint[3] = {0.35f, 0.60f, 0.95f};
-constexpr float kUpperGhostTint[3] = {0.95f, 0.35f, 0.35f};
-
 constexpr double kPi = 3.14159265358979323846;
 
 void put_u32(std::string& out, unsigned long v) {
@@ -186,12 +181,6 @@ RenderCamera frame_circle(const Eigen::Vector2d& center, double radius, double h
 }
 
 namespace {
-
-// The world-aligned box around an oriented box.
-Eigen::AlignedBox3d aligned(const Box& b) {
-  const Eigen::Vector3d reach = b.rotation.cwiseAbs() * b.half_size;
-  return Eigen::AlignedBox3d(b.center - reach, b.center + reach);
-}
 
 // Which volume boxes are faded: those that meet the fade region, and those that could hide part of
 // it (nearer to the camera than its far side, their picture overlapping its picture).
@@ -308,7 +297,7 @@ Image render_legend(int width, double max_top, bool ghosts, bool faded) {
     x += 26 + detail::text_width(text, 9);
   };
   if (ghosts) {
-    auto rgb = [](const float(&t)[3]) { return detail::Rgb{t[0], t[1], t[2]}; };
+    auto rgb = [](const std::array<float, 3>& t) { return detail::Rgb{t[0], t[1], t[2]}; };
     swatch(rgb(kLowerGhostTint), "ghost: joints at lower bound");
     swatch(rgb(kUpperGhostTint), "ghost: joints at upper bound");
   }
@@ -426,7 +415,7 @@ void add_ghost(const mjModel& m, mjData& d, mjvOption& opt, const Eigen::Vector3
       geom.rgba[3] = 0;
       continue;
     }
-    const float* tint = lower ? kLowerGhostTint : kUpperGhostTint;
+    const float* tint = lower ? kLowerGhostTint.data() : kUpperGhostTint.data();
     for (int c = 0; c < 3; ++c) geom.rgba[c] = tint[c];
     geom.rgba[3] = 0.28f;
     geom.segid = -1;

@@ -5,6 +5,7 @@
 #include <mujoco/mujoco.h>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 namespace leeway {
 
@@ -48,5 +49,8 @@ Box geom_box(const mjModel& m, const mjData& d, int geom);
 //! the clearance all skip them; check_scene reports a collidable plane as a problem instead (a
 //! floor must have contype="0" conaffinity="0", docs/mjcf-conventions.md).
 bool has_bounding_box(const mjModel& m, int geom);
+
+//! The world-aligned box around an oriented box [m].
+Eigen::AlignedBox3d aligned(const Box& b);
 
 }  // namespace leeway

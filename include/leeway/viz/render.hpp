@@ -105,6 +105,11 @@ struct RenderRequest {
   double faded_alpha = 0.08;
 };
 
+//! The ghosts' tints (RGB): every joint at its lower bound bluish, at its upper bound reddish
+//! (renders, their legend and the viewer).
+inline constexpr std::array<float, 3> kLowerGhostTint = {0.35f, 0.60f, 0.95f};
+inline constexpr std::array<float, 3> kUpperGhostTint = {0.95f, 0.35f, 0.35f};
+
 //! The height of the highest box's top [m] (its centre plus its half height); 0 for no box.
 double highest_top(const std::vector<Box>& boxes);
 

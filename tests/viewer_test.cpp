@@ -184,6 +184,12 @@ TEST_F(ViewerTest, MoreBoxesThanTheLimitAreRefusedNotThinned) {
   const std::string error = test::error_of([&] { viewer_data_json(s, c, options); });
   EXPECT_NE(error.find("the volume has 11 boxes, more than the viewer's limit of 10"), std::string::npos)
       << error;
+  // The default limit refuses a quarter of a million boxes.
+  c.volume.resize(250'000);
+  const std::string many = test::error_of([&] { viewer_data_json(s, c, ViewerOptions{}); });
+  EXPECT_NE(many.find("the volume has 250000 boxes, more than the viewer's limit of 200000"),
+            std::string::npos)
+      << many;
   // The cell's own geoms count too: floor, base, link and post are 4.
   c.volume.resize(8);
   const std::string cell = test::error_of([&] { viewer_data_json(s, c, options); });
@@ -285,6 +291,10 @@ TEST_F(CliViewTest, BadInputExitsTwoAndWritesNothing) {
     EXPECT_NE(r.out.find(c.message), std::string::npos) << c.args << "\n" << r.out;
     EXPECT_FALSE(fs::exists(path("v.html"))) << c.args;
   }
+  // An output folder that cannot be written, even by root.
+  const auto proc = run_cli("view " + workcell("dallara") + " --key patch --out /proc/leeway-view.html");
+  EXPECT_EQ(proc.exit_code, 2) << proc.out;
+  EXPECT_NE(proc.out.find("/proc/leeway-view.html"), std::string::npos) << proc.out;
   // An output folder that cannot be written.
   fs::create_directory(path("locked"));
   fs::permissions(path("locked"), fs::perms::owner_read | fs::perms::owner_exec);

@@ -8,7 +8,10 @@
 #include <random>
 #include <string>
 
+#include "leeway/core/certify.hpp"
 #include "leeway/core/kinematics.hpp"
+#include "leeway/core/params.hpp"
+#include "leeway/core/room.hpp"
 #include "leeway/core/safety.hpp"
 #include "test_util.hpp"
 
@@ -122,6 +125,75 @@ TEST_F(GrowTest, TwoLinkElbowGrowsToItsTouchLessTheMarginWhenOnlyItGrows) {
   EXPECT_LE(b[0].upper[1], kTouch2 - kWithinMargin2 + 1e-9);
   EXPECT_GE(b[0].upper[1], kTouch2 - kWithinMargin2 - 0.005);
   EXPECT_NEAR(b[0].lower[1], -2.5, 0.005);
+  EXPECT_GE(sampled_clearance(scene, b, 20000), 0.001 - 1e-9);
+}
+
+// The two-link arm at (0, 0) with j1 in [-0.05, 0.05]: link 2's corner (0.5, 0.05) from j2, at
+// absolute angle phi = j1 + j2 from j2's anchor (cos j1, sin j1), is highest at j1 = 0.05 and
+// reaches the wall at sin 0.05 + 0.5 sin phi + 0.05 cos phi = 0.45, j2 = phi - 0.05 = 0.77235 rad,
+// and comes within 1 mm 0.001 / (0.5 cos phi - 0.05 sin phi) = 0.00329 rad earlier.
+const double kPhi = std::asin((0.45 - std::sin(0.05)) / std::sqrt(0.2525)) - std::atan(0.1);
+const double kTouchAtJ1 = kPhi - 0.05;
+const double kWithinMarginAtJ1 = 0.001 / (0.5 * std::cos(kPhi) - 0.05 * std::sin(kPhi));
+
+// The box of one waypoint, proven again from scratch by a certifier of its own.
+bool recertified(const Scene& scene, const WaypointBounds& w) {
+  const Certifier certifier(scene);
+  CertifyContext ctx(scene);
+  CertifyStats stats;
+  return certifier.segment_free(ctx, w.lower, w.upper, w.lower, w.upper, CertifyBudget{1 << 20}, stats);
+}
+
+// The lever shape on the two-link arm: j2's share costs the tool 0.5 m per radian of its free
+// range (about 3.5 rad), j1's 1.5 m per radian (about 2.8 rad), so j2 grows first, and straight to
+// its free range's end with j1 still within its guide: the touch at j1 = 0.05 less the margin.
+// j1 then finds j2 at the wall above and grows below only, to its limit.
+TEST_F(GrowTest, LeverShapeGivesTheCheaperShareAllItCanTakeFirst) {
+  const Scene scene = Scene::load(dir_.write("two_link.xml", kTwoLink));
+  std::vector<WaypointBounds> b = {box(v2(0, 0), v2(-0.05, -0.05), v2(0.05, 0.05))};
+  SafetyParams params;
+  params.shape = "lever";
+  const SafetyReport r = make_safe(scene, b, params);
+  ASSERT_TRUE(r.all_passed);
+  EXPECT_LE(b[0].upper[1], kTouchAtJ1 - kWithinMarginAtJ1 + 1e-9);
+  EXPECT_GE(b[0].upper[1], kTouchAtJ1 - kWithinMarginAtJ1 - 0.005);
+  EXPECT_NEAR(b[0].lower[1], -2.5, 0.005);
+  EXPECT_LE(b[0].upper[0], 0.05 + 0.005);
+  EXPECT_NEAR(b[0].lower[0], -2.5, 0.005);
+  EXPECT_TRUE(recertified(scene, b[0]));
+  EXPECT_GE(sampled_clearance(scene, b, 50000), 0.001 - 1e-9);
+}
+
+// Greedy's rounds share the room instead: in the first round j1 rises to a third of its free range
+// above (0.09 rad), and j2 then stops short of the wall well below the lever shape's 0.77 rad. On
+// this arm the lever shape keeps the larger mean share; both results are certified.
+TEST_F(GrowTest, GreedyAndLeverShapesDifferAndBothAreCertified) {
+  const Scene scene = Scene::load(dir_.write("two_link.xml", kTwoLink));
+  const std::vector<WaypointBounds> guide = {box(v2(0, 0), v2(-0.05, -0.05), v2(0.05, 0.05))};
+  std::vector<WaypointBounds> greedy = guide, lever = guide;
+  SafetyParams params;
+  ASSERT_TRUE(make_safe(scene, greedy, params).all_passed);
+  params.shape = "lever";
+  ASSERT_TRUE(make_safe(scene, lever, params).all_passed);
+  EXPECT_GT(greedy[0].upper[0], 0.08);
+  EXPECT_LT(greedy[0].upper[1], lever[0].upper[1] - 0.1);
+  EXPECT_GT(measure_room(scene, lever).mean_share, measure_room(scene, greedy).mean_share);
+  EXPECT_TRUE(recertified(scene, greedy[0]));
+  EXPECT_TRUE(recertified(scene, lever[0]));
+}
+
+// On the one-link arm there is nothing to share: both shapes reach the wall less the margin.
+TEST_F(GrowTest, LeverShapeOnOneLinkReachesTheWallLessTheMargin) {
+  const Scene scene = Scene::load(dir_.write("one_link.xml", test::one_link_cell(kWall)));
+  std::vector<WaypointBounds> b = {box(v1(0.0), v1(-0.1), v1(0.1)), box(v1(0.3), v1(0.2), v1(0.4))};
+  SafetyParams params;
+  params.shape = "lever";
+  ASSERT_TRUE(make_safe(scene, b, params).all_passed);
+  for (const auto& w : b) {
+    EXPECT_LE(w.upper[0], kTouch - kWithinMargin + 1e-9);
+    EXPECT_GE(w.upper[0], kTouch - kWithinMargin - 0.005);
+    EXPECT_NEAR(w.lower[0], -3.0, 0.005);
+  }
   EXPECT_GE(sampled_clearance(scene, b, 20000), 0.001 - 1e-9);
 }
 

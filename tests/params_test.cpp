@@ -81,6 +81,7 @@ Params unusual() {
   p.bounds.half_width = {{"j5", 0.35}, {"rail_x", 0.5}};
   p.safety.grow = "j4,j6";
   p.safety.max_half_width = {{"j6", 0.25}};
+  p.safety.shape = "lever";
   p.cf.windows = 12;
   p.cf.samples = 500;
   p.cf.seed = 18446744073709551615ull;  // the largest seed: JSON must carry all 64 bits
@@ -117,6 +118,7 @@ void expect_equal(const Params& a, const Params& b) {
   EXPECT_EQ(a.bounds.half_width, b.bounds.half_width);
   EXPECT_EQ(a.safety.grow, b.safety.grow);
   EXPECT_EQ(a.safety.max_half_width, b.safety.max_half_width);
+  EXPECT_EQ(a.safety.shape, b.safety.shape);
   EXPECT_EQ(a.cf.windows, b.cf.windows);
   EXPECT_EQ(a.cf.samples, b.cf.samples);
   EXPECT_EQ(a.cf.seed, b.cf.seed);
@@ -141,8 +143,10 @@ TEST(ParamsJsonTest, KeysAreTheFieldNames) {
   EXPECT_EQ(j.at("bounds").at("linear_axis_tolerance"), 0.05);
   EXPECT_EQ(j.at("cf").at("seed"), 18446744073709551615ull);
   EXPECT_EQ(j.size(), 6u);
-  EXPECT_EQ(j.at("safety").size(), 8u);
+  EXPECT_EQ(j.at("safety").size(), 9u);
   EXPECT_EQ(j.at("safety").at("mode"), "certified");
+  EXPECT_EQ(j.at("safety").at("shape"), "lever");
+  EXPECT_EQ(to_json(Params{}).at("safety").at("shape"), "greedy");
   EXPECT_EQ(j.at("height_map").size(), 6u);
   EXPECT_EQ(j.at("volume").size(), 14u);  // 13 of section 4.1 and 3.2 plus trail_margin
   EXPECT_EQ(j.at("categorize").size(), 2u);
@@ -342,6 +346,19 @@ TEST(ParamsValidateTest, MessagesNameKeyAndValue) {
   p = Params{};
   p.volume.h_max = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(error_of([&] { p.validate(); }), "parameter 'volume.h_max' = nan must be a finite number");
+}
+
+TEST(ParamsValidateTest, UnknownShapeIsRefusedNamingIt) {
+  Params p;
+  p.safety.shape = "water";
+  EXPECT_EQ(error_of([&] { p.validate(); }), "parameter 'safety.shape' = 'water' must be greedy or lever");
+  for (const char* ok : {"greedy", "lever"}) {
+    p.safety.shape = ok;
+    EXPECT_NO_THROW(p.validate()) << ok;
+  }
+  const std::string m =
+      error_of([] { params_from_json(json::parse(R"({"safety": {"shape": 2}})"), "p.json"); });
+  EXPECT_NE(m.find("'safety.shape' must be a string"), std::string::npos) << m;
 }
 
 TEST(ParamsValidateTest, BoundaryValuesAreAccepted) {

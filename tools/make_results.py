@@ -135,6 +135,12 @@ def main():
     room = ROOT / "docs" / "data" / "room" / "section.md"
     if room.exists():
         o.append(room.read_text())
+    # The shape of growth, greedy against lever: tools/shape_study.py writes it; the notes are
+    # hand-written.
+    for name in ("shape.md", "shape_notes.md"):
+        shape = ROOT / "docs" / "data" / "room" / name
+        if shape.exists():
+            o.append(shape.read_text())
     # The closed loop: tools/make_simulate_results.py writes this section.
     simulate = ROOT / "docs" / "data" / "simulate" / "section.md"
     if simulate.exists():

@@ -73,6 +73,10 @@ void add_joint_bounds_options(CLI::App* sub, JointBoundsOptions& options) {
                   "Certified mode: the largest half-width a joint may keep [rad or m], e.g. j5=0.5,j6=0.3;\n"
                   "default: the parameters' safety.max_half_width (none)")
       ->check(non_empty_check("NAME=VALUE pairs, e.g. j5=0.5,j6=0.3"));
+  sub->add_option("--shape", options.shape,
+                  "Certified mode: how growth shares the room between joints: greedy (rounds, tip to\n"
+                  "base) or lever (cheapest share first); default: the parameters' safety.shape (greedy)")
+      ->check(non_empty_check("greedy or lever"));
 }
 
 namespace {
@@ -115,7 +119,7 @@ std::map<std::string, double> joint_values(const std::string& text, const std::s
 
 void apply_joint_bounds_options(const Scene& scene, const JointBoundsOptions& options, Params& p) {
   if (options.bisect.empty() && options.half_width.empty() && options.grow.empty() &&
-      options.max_half_width.empty())
+      options.max_half_width.empty() && options.shape.empty())
     return;
   // The preset, the cell's and the file's parameters alone first, so that what is refused below
   // comes from the flags.
@@ -137,6 +141,10 @@ void apply_joint_bounds_options(const Scene& scene, const JointBoundsOptions& op
   if (!options.max_half_width.empty()) {
     p.safety.max_half_width = joint_values(options.max_half_width, "--max-half-width", "largest half-width");
     given += (given.empty() ? "" : " / ") + std::string("--max-half-width ") + options.max_half_width;
+  }
+  if (!options.shape.empty()) {
+    p.safety.shape = options.shape;
+    given += (given.empty() ? "" : " / ") + std::string("--shape ") + options.shape;
   }
   try {
     validate_for_scene(p, scene);

@@ -228,18 +228,21 @@ void add_tool_option(CLI::App* sub, std::string& tool);
 //! Adds --preset and --safety to a subcommand that computes bounds.
 void add_preset_options(CLI::App* sub, std::string& preset, std::string& safety);
 
-//! --bisect, --half-width, --grow and --max-half-width as given (empty: not given).
+//! --bisect, --half-width, --grow, --max-half-width and --shape as given (empty: not given).
 struct JointBoundsOptions {
   std::string bisect;          //!< joint names, comma-separated: 'bounds.bisect'
   std::string half_width;      //!< NAME=VALUE pairs, comma-separated: 'bounds.half_width'
   std::string grow;            //!< all, none or joint names, comma-separated: 'safety.grow'
   std::string max_half_width;  //!< NAME=VALUE pairs, comma-separated: 'safety.max_half_width'
+  std::string shape;           //!< greedy or lever: 'safety.shape'
 };
 
-//! Adds --bisect, --half-width, --grow and --max-half-width to a subcommand that computes bounds.
+//! Adds --bisect, --half-width, --grow, --max-half-width and --shape to a subcommand that computes
+//! bounds.
 void add_joint_bounds_options(CLI::App* sub, JointBoundsOptions& options);
 
-//! Sets 'bounds.bisect', 'bounds.half_width', 'safety.grow' and 'safety.max_half_width' of `p` from
+//! Sets 'bounds.bisect', 'bounds.half_width', 'safety.grow', 'safety.max_half_width' and
+//! 'safety.shape' of `p` from
 //! the options given (after the preset, the
 //! cell's and the file's parameters) and checks the result against `scene` (validate_for_scene).
 //! @throws InputError naming the flag, the joint and the value.

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <memory>
 #include <sstream>
+#include <vector>
 
 #include "leeway/core/error.hpp"
 #include "leeway/core/kinematics.hpp"
@@ -14,10 +15,13 @@
 namespace leeway {
 namespace {
 
-// Growth runs in rounds: round r tries to widen every side of every grown joint to this fraction
-// of the room its one-joint free range leaves there, so that no joint takes the room another one
-// needs before every joint had its share (the shares rise together).
-constexpr double kRoundFractions[] = {1.0 / 3.0, 2.0 / 3.0, 1.0};
+// The greedy shape grows in rounds: round r tries to widen every side of every grown joint to
+// this fraction of the room its one-joint free range leaves there, so that no joint takes the room
+// another one needs before every joint had its share (the shares rise together).
+const std::vector<double> kRoundFractions = {1.0 / 3.0, 2.0 / 3.0, 1.0};
+// The lever shape takes one pass, each side straight to its target: the joints come in the order
+// of the cost of their share, and the cheapest is given all it can take first.
+const std::vector<double> kLeverFractions = {1.0};
 // Random configurations of each probe (besides the corners and centres it always checks).
 constexpr int kProbeSamples = 32;
 // The probe's bisection stops within this of its limit [rad for hinges, m for slides], and the
@@ -156,6 +160,43 @@ class WaypointGrowth {
   std::vector<std::pair<size_t, size_t>> segments_;
 };
 
+// One waypoint's targets, each side's extent to the end of the joint's one-joint free range
+// (capped), and the order in which its joints grow. Greedy: tip to base (the guide leaves the wrist
+// least of its room). Lever: by the cost of the joint's kept share, cheapest first (ties tip to
+// base). A share s of joint i's free range F_i moves the tool by about s F_i |J_i| (J_i the tool
+// site's Jacobian column at the nominal value, linear part), and every step's certificate must
+// cover what the step sweeps: maximising the sum of the shares under a bound on that motion is a
+// fractional knapsack, whose optimum fills the joints in increasing order of F_i |J_i|.
+struct WaypointTargets {
+  Eigen::VectorXd below, above;
+  std::vector<int> order;
+};
+
+WaypointTargets waypoint_targets(RobotState& state, const Eigen::VectorXd& q, const Eigen::VectorXd& caps,
+                                 bool lever) {
+  const int n = static_cast<int>(q.size());
+  const auto free = one_joint_free_ranges(state, q, kFreeRangeTolerance);
+  WaypointTargets t;
+  t.below.resize(n);
+  t.above.resize(n);
+  for (int i = 0; i < n; ++i) {
+    t.below[i] = std::min(caps[i], q[i] - free[static_cast<size_t>(i)].lower);
+    t.above[i] = std::min(caps[i], free[static_cast<size_t>(i)].upper - q[i]);
+  }
+  for (int i = n - 1; i >= 0; --i) t.order.push_back(i);
+  if (!lever) return t;
+  state.set(q);
+  const Eigen::MatrixXd jacobian = state.tool_jacobian();
+  std::vector<double> cost(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const FreeRange& f = free[static_cast<size_t>(i)];
+    cost[static_cast<size_t>(i)] = (f.upper - f.lower) * jacobian.col(i).head<3>().norm();
+  }
+  std::stable_sort(t.order.begin(), t.order.end(),
+                   [&](int a, int b) { return cost[static_cast<size_t>(a)] < cost[static_cast<size_t>(b)]; });
+  return t;
+}
+
 }  // namespace
 
 std::vector<bool> grow_mask(const Scene& scene, const SafetyParams& params) {
@@ -212,20 +253,13 @@ GrowReport grow_bounds(const Scene& scene, std::vector<WaypointBounds>& bounds,
     const bool after = k + 1 >= count || segments[k].passed;
     grows[k] = count == 1 ? segments[0].passed : before && after;
   }
-  // The targets: each side's extent to the end of the joint's one-joint free range, capped.
-  std::vector<Eigen::VectorXd> target_below(count), target_above(count);
+  const bool lever = params.shape == "lever";
+  std::vector<WaypointTargets> targets(count);
   detail::parallel_for(static_cast<int>(count), threads, [&] {
     auto state = std::make_shared<RobotState>(scene);
     return [&, state](int k) {
-      const WaypointBounds& w = bounds[static_cast<size_t>(k)];
-      const auto free = one_joint_free_ranges(*state, w.q, kFreeRangeTolerance);
-      Eigen::VectorXd below(n), above(n);
-      for (int i = 0; i < n; ++i) {
-        below[i] = std::min(caps[i], w.q[i] - free[static_cast<size_t>(i)].lower);
-        above[i] = std::min(caps[i], free[static_cast<size_t>(i)].upper - w.q[i]);
-      }
-      target_below[static_cast<size_t>(k)] = below;
-      target_above[static_cast<size_t>(k)] = above;
+      targets[static_cast<size_t>(k)] =
+          waypoint_targets(*state, bounds[static_cast<size_t>(k)].q, caps, lever);
     };
   });
   // blocked[k][2 i + side]: that side stopped short in an earlier round.
@@ -243,7 +277,7 @@ GrowReport grow_bounds(const Scene& scene, std::vector<WaypointBounds>& bounds,
     if (s + 1 < count) budget[s + 1] += half;
   }
   // A waypoint's slabs read its neighbours' bounds: even waypoints grow in parallel, then odd ones.
-  for (double fraction : kRoundFractions)
+  for (double fraction : lever ? kLeverFractions : kRoundFractions)
     for (size_t parity = 0; parity < 2; ++parity) {
       std::vector<size_t> jobs;
       for (size_t k = parity; k < count; k += 2)
@@ -253,16 +287,16 @@ GrowReport grow_bounds(const Scene& scene, std::vector<WaypointBounds>& bounds,
         return [&, ctx](int job) {
           const size_t k = jobs[static_cast<size_t>(job)];
           WaypointGrowth growth(certifier, *ctx, std::max(1L, budget[k]), bounds, k, slab_leaves, stats[k]);
-          // Tip to base: the guide leaves the wrist least of its room.
-          for (int i = n - 1; i >= 0; --i) {
+          const WaypointTargets& target = targets[k];
+          for (int i : target.order) {
             if (!mask[static_cast<size_t>(i)]) continue;
             const double tolerance =
                 scene.joints()[static_cast<size_t>(i)].prismatic ? kSlideTolerance : kHingeTolerance;
             for (int side = 0; side < 2; ++side) {
               char& stopped = blocked[k][static_cast<size_t>(2 * i + side)];
               if (stopped) continue;
-              const double target = fraction * (side ? target_above[k][i] : target_below[k][i]);
-              if (growth.grow(i, side, target, tolerance)) stopped = 1;
+              const double aim = fraction * (side ? target.above[i] : target.below[i]);
+              if (growth.grow(i, side, aim, tolerance)) stopped = 1;
             }
           }
         };

@@ -22,9 +22,10 @@ std::vector<bool> grow_mask(const Scene& scene, const SafetyParams& params);
 Eigen::VectorXd half_width_caps(const Scene& scene, const SafetyParams& params);
 
 //! Certified bounds (`segments` says which segments were proven) made wider, every growth proven:
-//! first every interval is capped at params.max_half_width; then, in rounds, each side of each
-//! grown joint at each waypoint whose segments are all certified is widened toward a share of the
-//! joint's one-joint free range (probe, then a certified slab, then bisection when it fails).
+//! first every interval is capped at params.max_half_width; then each side of each grown joint at
+//! each waypoint whose segments are all certified is widened toward the end of the joint's
+//! one-joint free range (probe, then a certified slab, then bisection when it fails), in rounds
+//! tip to base (params.shape "greedy") or in one pass, cheapest share first ("lever").
 //! Even waypoints, then odd ones, run in parallel on `threads` threads; the result does not depend
 //! on the thread count.
 GrowReport grow_bounds(const Scene& scene, std::vector<WaypointBounds>& bounds,

@@ -64,6 +64,7 @@ void for_each_field(P& p, F&& f) {
   f("safety", "seed", p.safety.seed);
   f("safety", "grow", p.safety.grow);
   f("safety", "max_half_width", p.safety.max_half_width);
+  f("safety", "shape", p.safety.shape);
 }
 
 const char* distance_name(DistanceMode m) { return m == DistanceMode::k3d ? "3d" : "plane"; }
@@ -272,6 +273,8 @@ void Params::validate() const {
   if (safety.grow.empty())
     throw InputError("parameter 'safety.grow' is empty: give all, none or joint names");
   require_joint_widths("safety.max_half_width", safety.max_half_width);
+  if (safety.shape != "greedy" && safety.shape != "lever")
+    throw InputError("parameter 'safety.shape' = '" + safety.shape + "' must be greedy or lever");
 }
 
 const char* safety_mode_name(SafetyMode mode) {

@@ -129,6 +129,11 @@ struct SafetyParams {
   //! Certified mode: the largest half-width growth may give a joint, by joint name [rad or m];
   //! joints not named are limited by their free range and joint limits only.
   std::map<std::string, double> max_half_width;
+  //! Certified mode: how growth shares the room between joints (docs/algorithm.md, "Growing"):
+  //! "greedy" (rounds of a third, two thirds and all of every side's target, tip to base) or
+  //! "lever" (one pass, the joint whose kept share costs the tool least motion first, each side
+  //! straight to its target).
+  std::string shape = "greedy";
 };
 
 //! All parameters.

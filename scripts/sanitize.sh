@@ -65,6 +65,9 @@ asan_skip+='|CliRenderTest\.SamePictureForOneAndTwoThreadsAndFromTheFile'
 # tests, BoundsFormatTest's others and GrowTest.
 asan_skip+='|UrdfImportCliTest\.SevenJointArmEndToEnd|SimulateDallaraTest\.SameSeedSameReport'
 asan_skip+='|BoundsFormatTest\.(CfThroughTheFileIsTheCfOfTheBounds|BadTimesNameTheFileAndWaypoint)'
+# The browser test's time is Chromium's (not instrumented); the viewer's C++ runs under ASan in the
+# other ViewerTest and CliViewTest tests.
+asan_skip+='|CliViewTest\.InChromiumTheSlidersStayWithinTheBoundsAndMoveTheRobot'
 
 run_address() {
   local dir="${1:-build-asan}"

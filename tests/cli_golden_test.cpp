@@ -91,7 +91,7 @@ std::vector<GoldenCase> golden_cases() {
   c.push_back({"help", "--help"});
   c.push_back({"version", "--version"});
   for (const std::string sub :
-       {"check", "fk", "ik", "plan", "bounds", "cf", "sweep", "params", "render", "plot", "simulate"})
+       {"check", "fk", "ik", "plan", "bounds", "cf", "sweep", "params", "render", "view", "plot", "simulate"})
     c.push_back({"help_" + sub, sub + " --help"});
   c.push_back({"help_import_urdf", "import-urdf --help"});
   c.push_back({"help_new_cell", "new-cell --help"});

@@ -347,6 +347,10 @@ std::string viewer_data_json(const Scene& scene, const ViewerContent& content, c
   } else {
     scene.validate_configuration(content.q, "shown configuration");
     out["q"] = std::vector<double>(content.q.data(), content.q.data() + content.q.size());
+    // Without bounds the joint sliders span the joints' limits: the cell can be explored.
+    const Eigen::VectorXd lower = scene.lower_limits(), upper = scene.upper_limits();
+    out["limits"] = {{"lower", std::vector<double>(lower.data(), lower.data() + lower.size())},
+                     {"upper", std::vector<double>(upper.data(), upper.data() + upper.size())}};
     robot = robot_extent(scene, {content.q});
   }
   const Eigen::AlignedBox3d framed = robot_neighbourhood(scene, robot, kNearObstacles);

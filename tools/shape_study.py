@@ -26,14 +26,11 @@ import sys
 import tempfile
 
 from machine_info import machine
+# The 15 sparse paths and the share format of the room study, one list for both studies.
+from make_room_results import PATHS, pct
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 DATA = ROOT / "docs" / "data" / "room" / "shape.json"
-PATHS = [("dallara", "home", "patch"), ("dallara", "patch", "mould"), ("dallara", "mould", "home"),
-         ("baltico", "home", "patch"), ("baltico", "patch", "mould"), ("baltico", "mould", "home"),
-         ("dlr", "home", "patch"), ("dlr", "patch", "mould"), ("dlr", "mould", "home"),
-         ("press_shop", "home", "pick"), ("press_shop", "pick", "place"), ("press_shop", "place", "home"),
-         ("rail_hall", "home", "patch"), ("rail_hall", "patch", "mould"), ("rail_hall", "mould", "home")]
 SHAPES = ["greedy", "lever"]
 MAX_J13_DROP = 0.02  # 2 points
 MAX_TIME_RATIO = 2.0
@@ -51,10 +48,6 @@ def measure(leeway, cell, src, dst, params_file):
     return {"mean_share": room["mean_share"], "j1": js["j1"], "j2": js["j2"], "j3": js["j3"],
             "j1_j3_share": (js["j1"] + js["j2"] + js["j3"]) / 3, "joint_share": js,
             "safety_ms": b["timing_ms"]["safety"], "certified": bool(b["safety"].get("certified", False))}
-
-
-def pct(x):
-    return "-" if x is None else f"{100 * x:.1f}"
 
 
 def render(data):

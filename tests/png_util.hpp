@@ -14,8 +14,19 @@
 
 namespace leeway::test {
 
-//! Decodes a PNG written by leeway::encode_png; throws std::runtime_error on anything else.
-inline Image decode_png(const std::string& bytes) {
+namespace detail {
+
+//! A PNG's header and its rows inflated, each row still led by its filter byte.
+struct InflatedPng {
+  int width = 0, height = 0;
+  std::string header;  //!< IHDR's bit depth, colour type, compression, filter and interlace bytes
+  std::string raw;     //!< height rows of 1 + channels * width bytes
+};
+
+//! Reads the chunks of a PNG and inflates its IDAT data for `channels` bytes per pixel, the count
+//! `channels_of` gives for the header's bytes; throws std::runtime_error on a malformed file.
+template <typename ChannelsOf>
+InflatedPng inflate_png(const std::string& bytes, ChannelsOf channels_of) {
   if (bytes.compare(0, 8, std::string("\x89PNG\r\n\x1a\n", 8)) != 0)
     throw std::runtime_error("no PNG signature");
   auto u32 = [&bytes](size_t at) {
@@ -23,32 +34,47 @@ inline Image decode_png(const std::string& bytes) {
     for (size_t k = 0; k < 4; ++k) v = (v << 8) | static_cast<unsigned char>(bytes.at(at + k));
     return v;
   };
-  Image image;
+  InflatedPng png;
   std::string packed;
   for (size_t at = 8; at + 8 <= bytes.size();) {
     const size_t len = u32(at);
     const std::string type = bytes.substr(at + 4, 4);
     if (type == "IHDR") {
-      image.width = static_cast<int>(u32(at + 8));
-      image.height = static_cast<int>(u32(at + 12));
-      if (bytes.substr(at + 16, 5) != std::string("\x08\x02\x00\x00\x00", 5))
-        throw std::runtime_error("not 8-bit RGB without interlace");
+      png.width = static_cast<int>(u32(at + 8));
+      png.height = static_cast<int>(u32(at + 12));
+      png.header = bytes.substr(at + 16, 5);
     }
     if (type == "IDAT") packed += bytes.substr(at + 8, len);
     at += 12 + len;
   }
-  const size_t row = 3 * static_cast<size_t>(image.width);
-  std::string raw((row + 1) * static_cast<size_t>(image.height), '\0');
-  uLongf size = static_cast<uLongf>(raw.size());
-  if (uncompress(reinterpret_cast<Bytef*>(raw.data()), &size, reinterpret_cast<const Bytef*>(packed.data()),
-                 static_cast<uLong>(packed.size())) != Z_OK ||
-      size != raw.size())
+  const size_t row = static_cast<size_t>(channels_of(png.header)) * static_cast<size_t>(png.width);
+  png.raw.assign((row + 1) * static_cast<size_t>(png.height), '\0');
+  uLongf size = static_cast<uLongf>(png.raw.size());
+  if (uncompress(reinterpret_cast<Bytef*>(png.raw.data()), &size,
+                 reinterpret_cast<const Bytef*>(packed.data()), static_cast<uLong>(packed.size())) != Z_OK ||
+      size != png.raw.size())
     throw std::runtime_error("IDAT does not inflate to the image size");
+  return png;
+}
+
+}  // namespace detail
+
+//! Decodes a PNG written by leeway::encode_png; throws std::runtime_error on anything else.
+inline Image decode_png(const std::string& bytes) {
+  const detail::InflatedPng png = detail::inflate_png(bytes, [](const std::string& header) {
+    if (header != std::string("\x08\x02\x00\x00\x00", 5))
+      throw std::runtime_error("not 8-bit RGB without interlace");
+    return 3;
+  });
+  Image image;
+  image.width = png.width;
+  image.height = png.height;
+  const size_t row = 3 * static_cast<size_t>(image.width);
   for (int y = 0; y < image.height; ++y) {
     const size_t start = (row + 1) * static_cast<size_t>(y);
-    if (raw[start] != '\0') throw std::runtime_error("a row filter other than 0");
-    image.rgb.insert(image.rgb.end(), raw.begin() + static_cast<long>(start + 1),
-                     raw.begin() + static_cast<long>(start + 1 + row));
+    if (png.raw[start] != '\0') throw std::runtime_error("a row filter other than 0");
+    image.rgb.insert(image.rgb.end(), png.raw.begin() + static_cast<long>(start + 1),
+                     png.raw.begin() + static_cast<long>(start + 1 + row));
   }
   return image;
 }
@@ -56,44 +82,25 @@ inline Image decode_png(const std::string& bytes) {
 //! Decodes an 8-bit RGB or RGBA PNG without interlace, any row filter (what browsers write for a
 //! screenshot); the alpha channel is dropped. Throws std::runtime_error on anything else.
 inline Image decode_browser_png(const std::string& bytes) {
-  if (bytes.compare(0, 8, std::string("\x89PNG\r\n\x1a\n", 8)) != 0)
-    throw std::runtime_error("no PNG signature");
-  auto u32 = [&bytes](size_t at) {
-    unsigned v = 0;
-    for (size_t k = 0; k < 4; ++k) v = (v << 8) | static_cast<unsigned char>(bytes.at(at + k));
-    return v;
-  };
-  Image image;
   int channels = 0;
-  std::string packed;
-  for (size_t at = 8; at + 8 <= bytes.size();) {
-    const size_t len = u32(at);
-    const std::string type = bytes.substr(at + 4, 4);
-    if (type == "IHDR") {
-      image.width = static_cast<int>(u32(at + 8));
-      image.height = static_cast<int>(u32(at + 12));
-      const int depth = bytes.at(at + 16), colour = bytes.at(at + 17), interlace = bytes.at(at + 20);
-      channels = colour == 2 ? 3 : colour == 6 ? 4 : 0;
-      if (depth != 8 || channels == 0 || interlace != 0)
-        throw std::runtime_error("not 8-bit RGB(A) without interlace");
-    }
-    if (type == "IDAT") packed += bytes.substr(at + 8, len);
-    at += 12 + len;
-  }
+  const detail::InflatedPng png = detail::inflate_png(bytes, [&channels](const std::string& header) {
+    const int depth = header.at(0), colour = header.at(1), interlace = header.at(4);
+    channels = colour == 2 ? 3 : colour == 6 ? 4 : 0;
+    if (depth != 8 || channels == 0 || interlace != 0)
+      throw std::runtime_error("not 8-bit RGB(A) without interlace");
+    return channels;
+  });
+  Image image;
+  image.width = png.width;
+  image.height = png.height;
   const size_t row = static_cast<size_t>(channels) * static_cast<size_t>(image.width);
-  std::string raw((row + 1) * static_cast<size_t>(image.height), '\0');
-  uLongf size = static_cast<uLongf>(raw.size());
-  if (uncompress(reinterpret_cast<Bytef*>(raw.data()), &size, reinterpret_cast<const Bytef*>(packed.data()),
-                 static_cast<uLong>(packed.size())) != Z_OK ||
-      size != raw.size())
-    throw std::runtime_error("IDAT does not inflate to the image size");
   std::vector<unsigned char> prior(row, 0), line(row);
   const size_t bpp = static_cast<size_t>(channels);
   for (int y = 0; y < image.height; ++y) {
     const size_t start = (row + 1) * static_cast<size_t>(y);
-    const int filter = static_cast<unsigned char>(raw[start]);
+    const int filter = static_cast<unsigned char>(png.raw[start]);
     for (size_t i = 0; i < row; ++i) {
-      const int x = static_cast<unsigned char>(raw[start + 1 + i]);
+      const int x = static_cast<unsigned char>(png.raw[start + 1 + i]);
       const int a = i >= bpp ? line[i - bpp] : 0, b = prior[i], c = i >= bpp ? prior[i - bpp] : 0;
       int predicted = 0;
       if (filter == 1)

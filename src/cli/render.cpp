@@ -86,6 +86,53 @@ std::optional<RenderInput> render_input(const RenderArgs& args, const Scene& sce
   return in;
 }
 
+void add_shown_path_options(CLI::App* sub, RenderArgs& args, CLI::Option* bounds) {
+  sub->add_option(
+         "--from", args.from,
+         "Start: a keyframe, site:NAME or xyz:X,Y,Z (bounds computed here, planned as leeway bounds plans)")
+      ->excludes(bounds);
+  sub->add_option("--to", args.to, "Goal: a keyframe, site:NAME or xyz:X,Y,Z")->excludes(bounds);
+  sub->add_option("--key", args.key, "Keyframe to show without bounds (default: the cell's first)")
+      ->excludes(bounds);
+}
+
+void add_shown_computation_options(CLI::App* sub, RenderArgs& args, CLI::Option* bounds) {
+  sub->add_flag("--no-plan", args.no_plan,
+                "Exit 1 when the straight path between two keyframes collides instead of planning around it")
+      ->excludes(bounds);
+  sub->add_option("--waypoints", args.waypoints, "Waypoints along the joint-linear path (with --from/--to)")
+      ->capture_default_str();
+  sub->add_option("--max-cells", args.max_cells, "MAX_cells of the height-map (with --from/--to)");
+  sub->add_option("--params", args.params, "Parameter file (JSON; with --from/--to)")
+      ->check(file_name_check());
+  add_preset_options(sub, args.preset, args.safety);
+  add_joint_bounds_options(sub, args.joints);
+  sub->add_option("--threads", args.threads, "Worker threads")->capture_default_str();
+  sub->final_callback([sub, &args] { args.max_cells_given = sub->count("--max-cells") > 0; });
+}
+
+void check_shown_path(const RenderArgs& args) {
+  const bool with_path = !args.from.empty() || !args.to.empty();
+  if (with_path && (args.from.empty() || args.to.empty()))
+    throw InputError("--from and --to go together (two keyframes)");
+  if (with_path && !args.key.empty())
+    throw InputError("--key shows a keyframe without bounds: not with --from/--to");
+}
+
+Params shown_params(const Scene& scene, const RenderArgs& args) {
+  Params p = load_params(scene, args.preset, args.params, args.safety);
+  if (args.max_cells_given) p.height_map.max_cells = args.max_cells;
+  p.validate();
+  apply_joint_bounds_options(scene, args.joints, p);
+  return p;
+}
+
+Eigen::VectorXd shown_keyframe(const Scene& scene, const RenderArgs& args) {
+  return !args.key.empty()            ? scene.keyframe(args.key).q
+         : !scene.keyframes().empty() ? scene.keyframes().front().q
+                                      : Eigen::VectorXd::Zero(scene.dof());
+}
+
 CLI::App* add_render(CLI::App& app, RenderArgs& args) {
   CLI::App* sub = app.add_subcommand(
       "render",
@@ -96,13 +143,7 @@ CLI::App* add_render(CLI::App& app, RenderArgs& args) {
   sub->add_option("cell", args.cell, "MJCF file of the workcell")->required();
   auto* bounds = sub->add_option("--bounds", args.bounds, "Bounds file written by leeway bounds --out")
                      ->check(file_name_check());
-  sub->add_option(
-         "--from", args.from,
-         "Start: a keyframe, site:NAME or xyz:X,Y,Z (bounds computed here, planned as leeway bounds plans)")
-      ->excludes(bounds);
-  sub->add_option("--to", args.to, "Goal: a keyframe, site:NAME or xyz:X,Y,Z")->excludes(bounds);
-  sub->add_option("--key", args.key, "Keyframe to show without bounds (default: the cell's first)")
-      ->excludes(bounds);
+  add_shown_path_options(sub, args, bounds);
   sub->add_option("--out", args.out, "PNG file to write")->check(file_name_check())->required();
   sub->add_option("--waypoint", args.waypoint, "Waypoint shown, from 0 (default: the last)")
       ->check(CLI::Validator(
@@ -141,18 +182,7 @@ CLI::App* add_render(CLI::App& app, RenderArgs& args) {
                   "Ghosts of the robot: corners (all joints at their lower, all at their upper bound),\n"
                   "joints (each joint at each bound) or none")
       ->capture_default_str();
-  sub->add_flag("--no-plan", args.no_plan,
-                "Exit 1 when the straight path between two keyframes collides instead of planning around it")
-      ->excludes(bounds);
-  sub->add_option("--waypoints", args.waypoints, "Waypoints along the joint-linear path (with --from/--to)")
-      ->capture_default_str();
-  sub->add_option("--max-cells", args.max_cells, "MAX_cells of the height-map (with --from/--to)");
-  sub->add_option("--params", args.params, "Parameter file (JSON; with --from/--to)")
-      ->check(file_name_check());
-  add_preset_options(sub, args.preset, args.safety);
-  add_joint_bounds_options(sub, args.joints);
-  sub->add_option("--threads", args.threads, "Worker threads")->capture_default_str();
-  sub->final_callback([sub, &args] { args.max_cells_given = sub->count("--max-cells") > 0; });
+  add_shown_computation_options(sub, args, bounds);
   return sub;
 }
 
@@ -211,10 +241,7 @@ Frame stage_frame(const Scene& scene, const BoundsStage& at, GhostMode ghosts) {
 std::vector<Frame> render_frames(const RenderArgs& args, const Scene& scene,
                                  const std::vector<WaypointBounds>& bounds, int k, GhostMode ghosts) {
   if (bounds.empty()) {
-    const Eigen::VectorXd q = !args.key.empty()            ? scene.keyframe(args.key).q
-                              : !scene.keyframes().empty() ? scene.keyframes().front().q
-                                                           : Eigen::VectorXd::Zero(scene.dof());
-    return {make_frame(scene, q, {})};
+    return {make_frame(scene, shown_keyframe(scene, args), {})};
   }
   if (args.strip == 0)
     return {make_frame(scene, bounds[static_cast<size_t>(k)].q,
@@ -251,11 +278,8 @@ void check_render_args(const RenderArgs& args) {
     throw InputError("--legend '" + args.legend + "' must be on or off");
   if (args.frame != "robot" && args.frame != "volume")
     throw InputError("--frame '" + args.frame + "' must be robot or volume");
+  check_shown_path(args);
   const bool with_path = !args.from.empty() || !args.to.empty();
-  if (with_path && (args.from.empty() || args.to.empty()))
-    throw InputError("--from and --to go together (two keyframes)");
-  if (with_path && !args.key.empty())
-    throw InputError("--key shows a keyframe without bounds: not with --from/--to");
   if (!with_path && args.bounds.empty() && args.waypoint != -1)
     throw InputError("--waypoint " + std::to_string(args.waypoint) +
                      ": there is no path without --bounds or --from/--to");
@@ -377,10 +401,7 @@ int run_render(const RenderArgs& args) {
                      " leaves frames " + std::to_string(frame_width) + " pixels wide (at least 16)");
 
   const auto scene = Scene::load(args.cell, scene_options(kDefaultTool));
-  Params p = load_params(scene, args.preset, args.params, args.safety);
-  if (args.max_cells_given) p.height_map.max_cells = args.max_cells;
-  p.validate();
-  apply_joint_bounds_options(scene, args.joints, p);
+  Params p = shown_params(scene, args);
   const bool show_volume = args.volume != "off";
   const std::optional<RenderInput> in = render_input(args, scene, p, show_volume);
   if (!in) return kExitFindings;

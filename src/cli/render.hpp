@@ -43,6 +43,19 @@ struct RenderArgs {
   int threads = default_threads();  //!< worker threads
 };
 
+//! Adds --from, --to and --key (what is shown besides --bounds, which they exclude) to `sub`.
+void add_shown_path_options(CLI::App* sub, RenderArgs& args, CLI::Option* bounds);
+//! Adds the options of bounds computed on the path (--no-plan, --waypoints, --max-cells, --params,
+//! the preset and joint options, --threads) to `sub`.
+void add_shown_computation_options(CLI::App* sub, RenderArgs& args, CLI::Option* bounds);
+//! @throws InputError on --from without --to (or the reverse), or --key with them.
+void check_shown_path(const RenderArgs& args);
+//! The parameters of bounds computed on the path: the preset, --params, --safety, --max-cells and
+//! the joint options. @throws InputError on invalid parameters.
+Params shown_params(const Scene& scene, const RenderArgs& args);
+//! The configuration shown without bounds: --key, else the cell's first keyframe, else zeros.
+Eigen::VectorXd shown_keyframe(const Scene& scene, const RenderArgs& args);
+
 //! What a picture or the viewer shows: the bounds (from the file, or computed on the nominal path as
 //! leeway bounds does), their volume, timing and safety record; no bounds for a bare cell.
 struct RenderInput {

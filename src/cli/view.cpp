@@ -1,6 +1,5 @@
 #include "cli/view.hpp"
 
-#include <fstream>
 #include <iostream>
 
 #include "leeway/core/file_io.hpp"
@@ -22,11 +21,7 @@ CLI::App* add_view(CLI::App& app, ViewArgs& args) {
   sub->add_option("cell", a.cell, "MJCF file of the workcell")->required();
   auto* bounds = sub->add_option("--bounds", a.bounds, "Bounds file written by leeway bounds --out")
                      ->check(file_name_check());
-  sub->add_option("--from", a.from, "Start: a keyframe, site:NAME or xyz:X,Y,Z (bounds computed here)")
-      ->excludes(bounds);
-  sub->add_option("--to", a.to, "Goal: a keyframe, site:NAME or xyz:X,Y,Z")->excludes(bounds);
-  sub->add_option("--key", a.key, "Keyframe to show without bounds (default: the cell's first)")
-      ->excludes(bounds);
+  add_shown_path_options(sub, a, bounds);
   sub->add_option("--out", a.out, "HTML file to write")->check(file_name_check())->required();
   sub->add_option("--volume", a.volume,
                   "The volume when the page opens: fade (boxes around the robot nearly clear), on or off\n"
@@ -35,17 +30,7 @@ CLI::App* add_view(CLI::App& app, ViewArgs& args) {
   sub->add_option("--max-boxes", args.max_boxes,
                   "Most volume boxes and cell geoms drawn; more is refused (exit 2), not thinned")
       ->capture_default_str();
-  sub->add_flag("--no-plan", a.no_plan,
-                "Exit 1 when the straight path between two keyframes collides instead of planning around it")
-      ->excludes(bounds);
-  sub->add_option("--waypoints", a.waypoints, "Waypoints along the joint-linear path (with --from/--to)")
-      ->capture_default_str();
-  sub->add_option("--max-cells", a.max_cells, "MAX_cells of the height-map (with --from/--to)");
-  sub->add_option("--params", a.params, "Parameter file (JSON; with --from/--to)")->check(file_name_check());
-  add_preset_options(sub, a.preset, a.safety);
-  add_joint_bounds_options(sub, a.joints);
-  sub->add_option("--threads", a.threads, "Worker threads")->capture_default_str();
-  sub->final_callback([sub, &a] { a.max_cells_given = sub->count("--max-cells") > 0; });
+  add_shown_computation_options(sub, a, bounds);
   return sub;
 }
 
@@ -58,38 +43,23 @@ int run_view(const ViewArgs& args) {
   if (a.volume != "fade" && a.volume != "on" && a.volume != "off")
     throw InputError("--volume '" + a.volume + "' must be fade, on or off");
   if (args.max_boxes < 0) throw InputError("--max-boxes " + std::to_string(args.max_boxes) + " must be >= 0");
-  const bool with_path = !a.from.empty() || !a.to.empty();
-  if (with_path && (a.from.empty() || a.to.empty()))
-    throw InputError("--from and --to go together (two keyframes)");
-  if (with_path && !a.key.empty())
-    throw InputError("--key shows a keyframe without bounds: not with --from/--to");
+  check_shown_path(a);
   require_threads(a.threads);
   ViewerOptions options;
   options.max_boxes = args.max_boxes;
   options.three_dir = default_three_dir();
   // three.js is looked for before the bounds are computed: a missing package is found at once.
-  for (const char* asset : {"/three.min.js", "/examples/js/controls/OrbitControls.js"})
-    if (!std::ifstream(options.three_dir + asset))
-      throw InputError(
-          options.three_dir + asset +
-          ": three.js is not there (Debian: apt-get install libjs-three; or set LEEWAY_THREE_DIR "
-          "to the folder holding three.min.js)");
+  require_three_js(options.three_dir);
 
   const auto scene = Scene::load(a.cell, scene_options(kDefaultTool));
-  Params p = load_params(scene, a.preset, a.params, a.safety);
-  if (a.max_cells_given) p.height_map.max_cells = a.max_cells;
-  p.validate();
-  apply_joint_bounds_options(scene, a.joints, p);
+  Params p = shown_params(scene, a);
   std::optional<RenderInput> in = render_input(a, scene, p, /*show_volume=*/false);
   if (!in) return kExitFindings;
 
   ViewerContent content;
   content.title = a.cell + (in->what.empty() ? "" : ": " + in->what);
   content.path = in->trajectory;
-  if (!content.path)
-    content.q = !a.key.empty()               ? scene.keyframe(a.key).q
-                : !scene.keyframes().empty() ? scene.keyframes().front().q
-                                             : Eigen::VectorXd::Zero(scene.dof());
+  if (!content.path) content.q = shown_keyframe(scene, a);
   content.volume = std::move(in->volume.boxes);
   content.safety_mode = in->bounds.empty() ? "" : in->safety_mode;
   content.proven = in->proven;

@@ -263,14 +263,21 @@ json volume_json(const std::vector<Box>& boxes) {
   return out;
 }
 
+// The files of libjs-three the page inlines.
+constexpr const char* kThreeJs = "three.min.js";
+constexpr const char* kOrbitControls = "examples/js/controls/OrbitControls.js";
+
+InputError three_js_missing(const std::string& path) {
+  return InputError(path +
+                    ": three.js is not there (Debian: apt-get install libjs-three; or set "
+                    "LEEWAY_THREE_DIR to the folder holding three.min.js)");
+}
+
 std::string read_asset(const std::string& dir, const std::string& name) {
   const std::string path = dir + "/" + name;
   std::ifstream in(path, std::ios::binary);
   std::ostringstream text;
-  if (!in || !(text << in.rdbuf()))
-    throw InputError(path +
-                     ": three.js is not there (Debian: apt-get install libjs-three; or set "
-                     "LEEWAY_THREE_DIR to the folder holding three.min.js)");
+  if (!in || !(text << in.rdbuf())) throw three_js_missing(path);
   return text.str();
 }
 
@@ -307,6 +314,11 @@ constexpr const char* kThreeLicence =
 std::string default_three_dir() {
   const char* env = std::getenv("LEEWAY_THREE_DIR");
   return env && *env ? env : LEEWAY_THREE_DIR;
+}
+
+void require_three_js(const std::string& dir) {
+  for (const char* name : {kThreeJs, kOrbitControls})
+    if (!std::ifstream(dir + "/" + name)) throw three_js_missing(dir + "/" + name);
 }
 
 std::string viewer_data_json(const Scene& scene, const ViewerContent& content, const ViewerOptions& options) {
@@ -364,8 +376,8 @@ std::string viewer_data_json(const Scene& scene, const ViewerContent& content, c
 
 std::string viewer_html(const Scene& scene, const ViewerContent& content, const ViewerOptions& options) {
   const std::string three_dir = options.three_dir.empty() ? default_three_dir() : options.three_dir;
-  const std::string three = read_asset(three_dir, "three.min.js");
-  const std::string controls = read_asset(three_dir, "examples/js/controls/OrbitControls.js");
+  const std::string three = read_asset(three_dir, kThreeJs);
+  const std::string controls = read_asset(three_dir, kOrbitControls);
   std::string page = detail::kViewerPage;
   replace_once(page, "/*LEEWAY_THREE_LICENCE*/", "/*\n" + std::string(kThreeLicence) + "\n*/");
   replace_once(page, "/*LEEWAY_THREE*/", script_safe(three));

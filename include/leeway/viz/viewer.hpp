@@ -50,6 +50,10 @@ inline constexpr double kViewerClearanceScale = 0.25;
 //! The folder libjs-three was found in at build time, or $LEEWAY_THREE_DIR when it is set.
 std::string default_three_dir();
 
+//! Checks that the three.js files the page inlines are readable in `dir`.
+//! @throws InputError naming the missing file (Debian: apt-get install libjs-three).
+void require_three_js(const std::string& dir);
+
 //! The page's data (the cell's bodies, joints and geoms, the samples of the path, the volume) as
 //! JSON, binary arrays as base64 of little-endian float32 or float64.
 //! @throws InputError when the boxes exceed options.max_boxes or the scene and path differ.

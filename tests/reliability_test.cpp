@@ -21,12 +21,13 @@
 #include <utility>
 #include <vector>
 
-#include "cli/common.hpp"
+#include "cli/support.hpp"
 #include "core/json_io.hpp"
 #include "core/parallel.hpp"
 #include "leeway/core/file_io.hpp"
 #include "leeway/core/kinematics.hpp"
 #include "leeway/core/mujoco_util.hpp"
+#include "leeway/core/params.hpp"
 #include "leeway/core/scene.hpp"
 #include "stl_util.hpp"
 #include "test_util.hpp"

@@ -8,7 +8,7 @@
 #include <iostream>
 #include <string>
 
-#include "cli/common.hpp"
+#include "cli/support.hpp"
 #include "distribute.hpp"
 #include "leeway/core/error.hpp"
 #include "leeway/core/file_io.hpp"

@@ -10,7 +10,7 @@
 #include <sstream>
 #include <thread>
 
-#include "cli/common.hpp"
+#include "cli/support.hpp"
 #include "core/json_io.hpp"
 #include "leeway/core/file_io.hpp"
 #include "leeway/core/mjcf_source.hpp"

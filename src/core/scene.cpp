@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "leeway/core/error.hpp"
-#include "leeway/core/params.hpp"
+#include "leeway/core/numbers.hpp"
 
 namespace leeway {
 namespace {
@@ -121,13 +121,6 @@ Keyframe keyframe_of(const mjModel& m, int k, const std::string& file,
 }
 
 }  // namespace
-
-std::string format_number(double v) {
-  std::ostringstream os;
-  os.precision(6);
-  os << v;
-  return os.str();
-}
 
 Eigen::VectorXd parse_vector(const std::string& text, const std::string& what) {
   std::vector<double> values;

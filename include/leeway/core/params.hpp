@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "leeway/core/numbers.hpp"
+
 namespace leeway {
 
 //! How the height function measures the distance from a cell to a box.
@@ -23,10 +25,6 @@ enum class DistanceMode {
 //! Params::validate, make_grid and the programs' options all check against this one value.
 constexpr int kMaxCellsLimit = 1000000;
 
-//! Physical bounds on the input: a workcell is metres across, so lengths (parameters,
-//! joint ranges of slide joints [m], obstacle positions and sizes) and hinge ranges [rad] beyond
-//! this are refused as mistakes; they would only produce unusable bounds or overflow.
-constexpr double kMaxLength = 1e3;
 //! The smallest height-map side and reach radius [m]: below it the map's cell size underflows.
 constexpr double kMinMapSide = 1e-3;
 //! The smallest Algorithm-1 descent step 'categorize.goal_dz' [m] (smaller ones run for ever).

@@ -9,6 +9,7 @@
 
 #include "leeway/core/collision.hpp"
 #include "leeway/core/mujoco_util.hpp"
+#include "leeway/core/numbers.hpp"
 
 namespace leeway {
 
@@ -147,8 +148,5 @@ class Scene {
 //! Parses "q1 q2 ..." (spaces or commas) into a vector. @throws InputError naming `what` and the
 //! offending token when a token is not a finite number.
 Eigen::VectorXd parse_vector(const std::string& text, const std::string& what);
-
-//! Formats a value compactly with up to 6 significant digits.
-std::string format_number(double v);
 
 }  // namespace leeway

@@ -154,9 +154,7 @@ void check_options(Options& o) {
           "give a budget: --budget-evals N or --budget-seconds S");
   require(o.repeats >= 1, "--repeats " + std::to_string(o.repeats) + " must be >= 1");
   require(o.final_repeats >= 1, "--final-repeats must be >= 1");
-  require(o.threads >= 1 && o.threads <= leeway::cli::kMaxThreads,
-          "--threads " + std::to_string(o.threads) + " must be from 1 to " +
-              std::to_string(leeway::cli::kMaxThreads));
+  leeway::cli::require_threads(o.threads);
   require(o.cf.windows >= 1 && o.cf.samples >= 1, "--cf-windows and --cf-samples must be >= 1");
   leeway::cli::require_memory(o.cf.windows * leeway::cli::kBytesPerWindow,
                               "--cf-windows " + std::to_string(o.cf.windows));

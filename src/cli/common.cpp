@@ -199,12 +199,6 @@ bool plan_between(const Scene& scene, const std::string& from, const std::string
   return true;
 }
 
-void require_threads(int threads, const std::string& flag) {
-  if (threads < 1 || threads > kMaxThreads)
-    throw InputError(flag + " " + std::to_string(threads) + " must be from 1 to " +
-                     std::to_string(kMaxThreads));
-}
-
 std::pair<int, int> parse_size(const std::string& text, const std::string& flag) {
   static const std::regex re("([0-9]{1,5})[xX]([0-9]{1,5})");
   std::smatch m;

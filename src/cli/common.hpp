@@ -20,9 +20,6 @@ namespace leeway::cli {
 //! The tool site's name unless --tool gives another.
 inline const char* const kDefaultTool = "tool0";
 
-//! Checks --threads: from 1 to kMaxThreads. @throws InputError naming the flag and the value.
-void require_threads(int threads, const std::string& flag = "--threads");
-
 //! Scene options with the given tool site and collision checker ("midphase" or "mujoco").
 //! @throws InputError on an unknown checker.
 SceneOptions scene_options(const std::string& tool, const std::string& checker = "midphase");

@@ -27,6 +27,13 @@ namespace leeway::cli {
 //! Most worker threads a program accepts (--threads).
 inline constexpr int kMaxThreads = 256;
 
+//! Checks --threads: from 1 to kMaxThreads. @throws InputError naming the flag and the value.
+inline void require_threads(int threads, const std::string& flag = "--threads") {
+  if (threads < 1 || threads > kMaxThreads)
+    throw InputError(flag + " " + std::to_string(threads) + " must be from 1 to " +
+                     std::to_string(kMaxThreads));
+}
+
 //! Parses argv into `app`. Returns the exit code the program should return now (0 after --help or
 //! --version, kExitBadInput after a parse error, reported as one line "PROGRAM: error: ..." on
 //! standard error), or nothing when the program should go on.

@@ -1,6 +1,7 @@
 // Growth beyond the guide in the certified mode: on hand-worked arms the grown bound reaches the
 // analytic touch angle less the margin, never more; caps and joint choices are kept; every grown
-// region is free when sampled densely.
+// region is free when sampled densely. And the run boxes of dense paths (the same two-link arm and
+// dense sampling): what they prove is free.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -208,6 +209,42 @@ TEST_F(GrowTest, TwoLinkGrowingBothJointsStaysFree) {
   EXPECT_GT(b[0].upper[0] - b[0].lower[0], 0.1 + 1e-3);
   EXPECT_GT(b[1].upper[1] - b[1].lower[1], 0.1 + 1e-3);
   EXPECT_GE(sampled_clearance(scene, b, 50000), 0.001 - 1e-9);
+}
+
+TEST_F(GrowTest, RunBoxesOfADenseTwoLinkPathNearTheWallAreFree) {
+  // 81 waypoints, j1 from -0.3 to -0.1 rad and j2 from 0.5 to 0.7 rad (2.5 mrad apart), the guide
+  // j1 +-0.1 and j2 0.3 below and 0.8 above the nominal: through the wall (link 2's far corner is at
+  // y = sin j1 + 0.5 sin(j1 + j2) + 0.05 cos(j1 + j2), 0.22 m at the last nominal, 0.50 m at its
+  // guide's upper corner; the wall is at 0.45), so phase-0 segments shrink and the others start
+  // warm and are proven by their chain's run boxes. The result must be free with the margin between the
+  // waypoints too, the same for one thread and two, and about as wide as proving every segment
+  // on its own.
+  const Scene scene = Scene::load(dir_.write("two_link.xml", kTwoLink));
+  std::vector<WaypointBounds> b;
+  for (int k = 0; k <= 80; ++k) {
+    const Eigen::VectorXd q = v2(-0.3 + 0.0025 * k, 0.5 + 0.0025 * k);
+    b.push_back(box(q, q - v2(0.1, 0.3), q + v2(0.1, 0.8)));
+  }
+  std::vector<WaypointBounds> two_threads = b, without = b;
+  SafetyParams params;
+  const SafetyReport r = make_safe(scene, b, params, 1);
+  make_safe(scene, two_threads, params, 2);
+  params.runs = false;
+  const SafetyReport off = make_safe(scene, without, params, 1);
+  ASSERT_TRUE(r.all_passed);
+  ASSERT_TRUE(off.all_passed);
+  EXPECT_GT(r.run_segments, 40);
+  EXPECT_LT(r.stats.leaves, off.stats.leaves);
+  EXPECT_GE(sampled_clearance(scene, b, 2000), 0.001 - 1e-9);
+  double width = 0, width_off = 0;
+  for (size_t k = 0; k < b.size(); ++k) {
+    SCOPED_TRACE(k);
+    EXPECT_EQ(b[k].lower, two_threads[k].lower);
+    EXPECT_EQ(b[k].upper, two_threads[k].upper);
+    width += b[k].upper[1] - b[k].lower[1];
+    width_off += without[k].upper[1] - without[k].lower[1];
+  }
+  EXPECT_GT(width, 0.95 * width_off);
 }
 
 TEST_F(GrowTest, CapsNarrowAndNoneKeepsTheCertifiedBounds) {

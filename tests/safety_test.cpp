@@ -96,6 +96,7 @@ TEST_F(OneLinkSafetyTest, ADensePathIsCertifiedAsWideAsATwoWaypointOne) {
   make_safe(*scene_, two_threads, SafetyParams{}, 2);
   ASSERT_EQ(r.segments.size(), 60u);
   EXPECT_TRUE(r.all_passed);
+  EXPECT_GT(r.run_segments, 0);  // run boxes proved some segments (next to the wall)
   for (size_t k = 0; k < dense.size(); ++k) {
     SCOPED_TRACE(k);
     EXPECT_LE(dense[k].upper[0], kTouch - kWithinMargin + 1e-9);
@@ -134,6 +135,66 @@ TEST_F(OneLinkSafetyTest, ADensePathWidensAgainWhereItsGuideWidens) {
     }
     EXPECT_EQ(dense[k].lower[0], -0.5);
     EXPECT_EQ(dense[k].upper[0], two_threads[k].upper[0]);
+  }
+}
+
+TEST_F(OneLinkSafetyTest, RunBoxesProveAFreeDensePathAsTheSegmentsWouldWithFewerLeaves) {
+  // 61 waypoints 5 mrad apart (nominal 0 .. 0.3 rad), the guide 0.4 rad above the nominal and
+  // 0.5 below: everything is free (at most 0.7 rad, the wall is at 1.1995). Every warm segment
+  // (all but those of phase 0: 0, 16, 32 and 48) is then proven by its chain's run box (one box for
+  // up to 16 waypoints ahead), and the bounds are exactly those of proving every segment on its own
+  // (safety.runs = false): warm starts and widenings are the same, only the proofs change.
+  std::vector<WaypointBounds> with_runs;
+  for (int k = 0; k <= 60; ++k) with_runs.push_back(box_around(0.005 * k, 0.005 * k - 0.5, 0.005 * k + 0.4));
+  std::vector<WaypointBounds> without = with_runs;
+  SafetyParams params;
+  params.grow = "none";
+  const SafetyReport r = make_safe(*scene_, with_runs, params, 1);
+  params.runs = false;
+  const SafetyReport off = make_safe(*scene_, without, params, 1);
+  ASSERT_TRUE(r.all_passed);
+  ASSERT_TRUE(off.all_passed);
+  EXPECT_EQ(r.run_segments, 56);
+  EXPECT_GT(r.run_leaves, 0);
+  EXPECT_EQ(off.run_segments, 0);
+  EXPECT_EQ(off.run_leaves, 0);
+  for (size_t k = 0; k < r.segments.size(); ++k) EXPECT_EQ(r.segments[k].run, k % 16 != 0) << k;
+  EXPECT_LT(r.stats.leaves, off.stats.leaves);
+  for (size_t k = 0; k < with_runs.size(); ++k) {
+    SCOPED_TRACE(k);
+    EXPECT_EQ(with_runs[k].lower[0], without[k].lower[0]);
+    EXPECT_EQ(with_runs[k].upper[0], without[k].upper[0]);
+  }
+}
+
+TEST_F(OneLinkSafetyTest, TheBoundsFileSaysWhichSegmentsRunBoxesProved) {
+  // The dense path above through the command line (a path file): safety.runs and the segments'
+  // `run` flags agree, and safety.runs = false turns them off.
+  json path = {{"format", "leeway-path-1"}, {"joints", {"j1"}}, {"waypoints", json::array()}};
+  for (int k = 0; k <= 60; ++k) path["waypoints"].push_back({{"q", {0.005 * k}}});
+  const std::string path_file = dir_.write("path.json", path.dump());
+  const std::string off = dir_.write("off.json", R"({"safety": {"runs": false}})");
+  for (const bool runs : {true, false}) {
+    SCOPED_TRACE(runs);
+    const auto out = dir_.path() / "b.json";
+    const auto r = run_cli("bounds " + path_ + " --path " + path_file + " --threads 1 --room off --out " +
+                           out.string() + (runs ? "" : " --params " + off));
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    const json j = read_json(out);
+    EXPECT_TRUE(j["safety"]["certified"].get<bool>());
+    const json& report = j["safety"]["runs"];
+    EXPECT_EQ(report["enabled"].get<bool>(), runs);
+    int flagged = 0;
+    for (const auto& s : j["safety"]["segments"]) flagged += s.value("run", false) ? 1 : 0;
+    EXPECT_EQ(report["segments"].get<int>(), flagged);
+    if (runs) {
+      EXPECT_GT(flagged, 0);
+      EXPECT_GT(report["leaves"].get<long>(), 0);
+      EXPECT_LE(report["leaves"].get<long>(), j["safety"]["leaves"].get<long>());
+    } else {
+      EXPECT_EQ(flagged, 0);
+      EXPECT_EQ(report["leaves"].get<long>(), 0);
+    }
   }
 }
 

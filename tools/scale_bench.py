@@ -10,10 +10,14 @@
   2. `leeway check` on a cell with 20,000 extra obstacles (4 x 4 x 20 cm boxes at seeded random
      places over 8 x 8 m, overlaps included); target <= 5 s.
 
+With --compare-runs, each path is also bounded once with `safety.runs` = false (every segment of
+the dense path proven on its own, as before run boxes; docs/algorithm.md, "Run boxes"), and a
+second table compares the two: wall and CPU time, leaves, and each joint's mean interval width.
+
 Every input is generated into a temporary folder (nothing is written to the repository); each case
 runs --repeats times and the table gives the median wall time [s], the CPU time [s] and what the
 run reported. Usage: python3 tools/scale_bench.py [--build build] [--repeats 3] [--waypoints 1000]
-[--obstacles 20000] [--only bounds|check] [--path-case CELL:FROM:TO ...]
+[--obstacles 20000] [--only bounds|check] [--path-case CELL:FROM:TO ...] [--compare-runs]
 """
 import argparse
 import json
@@ -89,6 +93,8 @@ def main():
     ap.add_argument("--waypoints", type=int, default=1000)
     ap.add_argument("--obstacles", type=int, default=20000)
     ap.add_argument("--only", choices=["bounds", "check"], help="run one of the two cases")
+    ap.add_argument("--compare-runs", action="store_true",
+                    help="also bound each path once with safety.runs = false and compare (a second table)")
     ap.add_argument("--out", help="also write the table as a docs section here (docs/data/perf/scale.md, "
                                   "which tools/make_results.py includes in docs/results.md)")
     ap.add_argument("--path-case", action="append", metavar="CELL:FROM:TO",
@@ -97,6 +103,7 @@ def main():
     args = ap.parse_args()
     LEEWAY = str((ROOT / args.build / "leeway").resolve())
     rows = []
+    compared = []  # (case, with runs: (wall, cpu, bounds json), without: (wall, cpu, bounds json))
     with tempfile.TemporaryDirectory() as tmp:
         folder = pathlib.Path(tmp)
         cases = args.path_case or DEFAULT_CASES
@@ -119,6 +126,15 @@ def main():
                     f"the guide's; cf --self: {cf['obstacle_collisions']} obstacle and {cf['self_collisions']} "
                     f"self-collisions in {cf['samples']} samples")
             rows.append((f"bounds {name} {a}-{b} --path ({args.waypoints} waypoints)", runs, 30.0, note))
+            if args.compare_runs:
+                off = folder / "runs_off.json"
+                off.write_text(json.dumps({"safety": {"runs": False}}))
+                out_off = folder / "bounds_off.json"
+                run_off = timed([LEEWAY, "bounds", str(cell), "--path", str(p), "--params", str(off),
+                                 "--out", str(out_off)])
+                with_runs = (statistics.median(r[0] for r in runs), statistics.median(r[1] for r in runs), d)
+                compared.append((f"{name} {a}-{b}", with_runs,
+                                 (run_off[0], run_off[1], json.loads(out_off.read_text()))))
         if args.only != "bounds":
             cell = crowded_cell(folder, ROOT / "mjcf" / "workcells" / "shelf_bay.xml", args.obstacles, 1)
             # Exit 1: check's findings (the random boxes overlap each other and the robot's reach).
@@ -134,6 +150,24 @@ def main():
         wall = statistics.median(r[0] for r in runs)
         cpu = statistics.median(r[1] for r in runs)
         lines.append(f"| {name} | {wall:.2f} | {cpu:.2f} | {target:g} | {'yes' if wall <= target else 'NO'} | {note} |")
+    if compared:
+        lines += ["", "Run boxes against every segment proven on its own (`safety.runs` = false, one run each; "
+                  "the times with run boxes are the medians above). *width* = each joint's mean interval "
+                  "width over the waypoints with run boxes, as a share of its width without them [%].", "",
+                  "| path | wall [s]: runs / without | CPU [s]: runs / without | leaves: runs / without | "
+                  "segments proven by run boxes | width per joint [%] |",
+                  "|---|---:|---:|---:|---:|---|"]
+        for case, (wall, cpu, d), (wall_off, cpu_off, d_off) in compared:
+            joints = d["joints"]
+            def mean_width(doc, i):
+                return statistics.mean(w["upper"][i] - w["lower"][i] for w in doc["waypoints"])
+            shares = ", ".join(
+                f"{name} {100 * mean_width(d, i) / mean_width(d_off, i):.1f}" if mean_width(d_off, i) > 0
+                else f"{name} -" for i, name in enumerate(joints))
+            s, s_off = d["safety"], d_off["safety"]
+            lines.append(f"| {case} | {wall:.2f} / {wall_off:.2f} | {cpu:.2f} / {cpu_off:.2f} | "
+                         f"{s['leaves']} / {s_off['leaves']} | {s['runs']['segments']} of {len(s['segments'])} | "
+                         f"{shares} |")
     print("\n".join(lines))
     if args.out:
         section = ["## Scale (issue 14)", "",

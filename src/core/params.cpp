@@ -65,6 +65,7 @@ void for_each_field(P& p, F&& f) {
   f("safety", "grow", p.safety.grow);
   f("safety", "max_half_width", p.safety.max_half_width);
   f("safety", "shape", p.safety.shape);
+  f("safety", "runs", p.safety.runs);
 }
 
 const char* distance_name(DistanceMode m) { return m == DistanceMode::k3d ? "3d" : "plane"; }

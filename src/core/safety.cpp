@@ -39,6 +39,12 @@ constexpr size_t kDensePhases = 16;
 constexpr size_t kWidenEvery = 4;
 // Random configurations a probe checks besides the corners.
 constexpr int kProbeSamples = 200;
+// A run's box (RunBox) holds the segments up to this many waypoints ahead; its proof gets the leaf
+// budget over kRunBudgetDivisor (a failing proof costs all of it), and a chain of segments stops
+// trying new run boxes after kMaxRunFailures failed ones.
+constexpr size_t kRunWaypoints = 16;
+constexpr long kRunBudgetDivisor = 4;
+constexpr int kMaxRunFailures = 2;
 
 // The bounds as the nominal value and the extents below and above it, which shrink independently.
 struct Extents {
@@ -85,6 +91,21 @@ void halve(double& extent) { extent = extent / 2 < kTinyExtent ? 0.0 : extent / 
 using detail::splitmix;
 using detail::unit;
 
+// What the warm segments of one chain on a dense path share (a chain: the segments from one of
+// phase 0 to the next, which run one after the other, each warm from the one before; the first,
+// cold one starts from the guide, which on dense paths is rarely free). A box proven free that
+// holds the boxes of several of its consecutive segments: a segment whose box (the hull of its two ends'
+// boxes, which holds its box at every t) lies inside it is certified without a proof of its own.
+// And the joint sides whose widening (kWidenEvery) the certificate refused in this chain: its later
+// segments do not try them again, since they fail in most cases and each failure costs a thin
+// slab's budget.
+struct RunBox {
+  Eigen::VectorXd lower, upper;
+  bool proven = false;
+  int failures = 0;
+  std::vector<char> refused;  // [2 i + side]
+};
+
 // Which neighbouring segments share the segment's waypoints and ran before it (a regrown waypoint
 // must keep them certified), and whether they were certified.
 struct Neighbours {
@@ -106,7 +127,7 @@ struct Neighbours {
 class SegmentRepair {
  public:
   SegmentRepair(const Certifier& certifier, CertifyContext& ctx, long leaf_limit, Extents& e,
-                const Extents& guide, size_t a, size_t b, const Neighbours& nb)
+                const Extents& guide, size_t a, size_t b, const Neighbours& nb, RunBox* run)
       : certifier_(certifier),
         ctx_(ctx),
         e_(e),
@@ -115,7 +136,8 @@ class SegmentRepair {
         b_(b),
         nb_(nb),
         n_(static_cast<int>(e.q[a].size())),
-        short_(is_short(guide, a, b)) {
+        short_(is_short(guide, a, b)),
+        run_(short_ && a != b && nb.check_previous ? run : nullptr) {
     budget_ = certifier.budget();
     budget_.leaf_limit = leaf_limit;
   }
@@ -176,7 +198,50 @@ class SegmentRepair {
     }
   }
 
+  // Whether the run's box is proven and holds the box of segment (from, to) at the extents set.
+  bool run_box_holds(size_t from, size_t to) const {
+    if (!run_ || !run_->proven) return false;
+    return (run_->lower.array() <= e_.lower(from).cwiseMin(e_.lower(to)).array()).all() &&
+           (e_.upper(from).cwiseMax(e_.upper(to)).array() <= run_->upper.array()).all();
+  }
+
+  // The run's box: whether it holds this segment's box, proving a new one first when it does not
+  // (and the chain has not failed too often). A new box holds this segment's two ends and the
+  // nominal values of the next kRunWaypoints waypoints: a later segment of the chain starts from
+  // its neighbour's intervals, clipped at its nominal value (warm_start), so unless it widens its
+  // box lies inside that one.
+  bool in_run_box() {
+    if (!run_) return false;
+    if (run_box_holds(a_, b_)) return true;
+    if (run_->failures >= kMaxRunFailures) return false;
+    const Eigen::VectorXd lower = e_.lower(a_).cwiseMin(e_.lower(b_)),
+                          upper = e_.upper(a_).cwiseMax(e_.upper(b_));
+    const size_t last = std::min(a_ + kRunWaypoints, e_.q.size() - 1);
+    CertifyBudget budget = budget_;
+    budget.max_leaves = std::max(64L, budget_.max_leaves / kRunBudgetDivisor);
+    Eigen::VectorXd box_lower = lower, box_upper = upper;
+    for (size_t k = b_ + 1; k <= last; ++k) {
+      box_lower = box_lower.cwiseMin(e_.q[k]);
+      box_upper = box_upper.cwiseMax(e_.q[k]);
+    }
+    const long before = stats_.leaves;
+    const bool proven = certifier_.region_free(ctx_, box_lower, box_upper, budget, stats_);
+    s_.run_leaves += stats_.leaves - before;
+    if (proven) {
+      run_->lower = box_lower;
+      run_->upper = box_upper;
+      run_->proven = true;
+      return true;
+    }
+    ++run_->failures;
+    return false;
+  }
+
   void shrink_until_certified() {
+    if (in_run_box()) {
+      s_.passed = s_.run = true;
+      return;
+    }
     while (s_.shrink_steps < kMaxShrinkSteps) {
       CertifyFailure f;
       if (probed(a_, b_, &f) && certified(a_, b_, &f)) {
@@ -282,9 +347,17 @@ class SegmentRepair {
     const double shrunk_to = extent, guide_extent = side ? target_above_[end][i] : target_below_[end][i];
     if (!(guide_extent > shrunk_to)) return;
     const bool previous = nb_.check_previous && k == a_, next = nb_.check_next && k == b_ && a_ != b_;
-    // The largest extent the probe does not reject, by bisection (cheap) ...
+    // A widening the chain was refused before is not tried again (RunBox).
+    const bool widening = widen_b_ && s_.shrink_steps == 0 && run_;
+    if (widening) run_->refused.resize(static_cast<size_t>(2 * n_), 0);
+    if (widening && run_->refused[static_cast<size_t>(2 * i + side)]) return;
+    // Inside the run's box the whole way back needs no proof (nor a probe) ...
+    extent = guide_extent;
+    if (run_box_holds(a_, b_) && (!previous || run_box_holds(a_ - 1, a_)) &&
+        (!next || run_box_holds(b_, b_ + 1)))
+      return;
+    // ... else the largest extent the probe does not reject, by bisection (cheap) ...
     double ok = shrunk_to, bad = guide_extent;
-    extent = bad;
     if (probe_all(k)) {
       ok = bad;
     } else {
@@ -319,6 +392,8 @@ class SegmentRepair {
       }
     }
     extent = ok;
+    if (widening && ok == shrunk_to && probe_limit > shrunk_to)
+      run_->refused[static_cast<size_t>(2 * i + side)] = 1;
   }
 
   const Certifier& certifier_;
@@ -329,6 +404,7 @@ class SegmentRepair {
   const Neighbours nb_;
   const int n_;
   const bool short_;
+  RunBox* const run_;  // the chain's run box (dense paths, short segments), or null
   CertifyBudget budget_;
   SegmentSafety s_;
   CertifyStats stats_;
@@ -428,6 +504,8 @@ SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, 
     // A dense path (at least half its segments short) takes kDensePhases phases: every segment but
     // those of phase 0 then has a settled neighbour to start warm from.
     const size_t phases = dense ? kDensePhases : 3;
+    // One run box per chain of warm starts (the segments of one chain run one after another).
+    std::vector<RunBox> runs(dense && params.runs ? segments / phases + 1 : 0);
     for (size_t phase = 0; phase < phases; ++phase) {
       std::vector<size_t> jobs;
       for (size_t s = phase; s < segments; s += phases) jobs.push_back(s);
@@ -442,12 +520,16 @@ SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, 
           nb.previous_certified = nb.check_previous && report.segments[s - 1].passed;
           nb.next_certified = nb.check_next && report.segments[s + 1].passed;
           SegmentRepair repair(certifier, *ctx, leaf_limit, e, guide, s, std::min(s + 1, bounds.size() - 1),
-                               nb);
+                               nb, runs.empty() ? nullptr : &runs[s / phases]);
           report.segments[s] = repair.run(stats[s]);
         };
       });
     }
     for (const auto& st : stats) report.stats.add(st);
+    for (const auto& seg : report.segments) {
+      report.run_segments += seg.run ? 1 : 0;
+      report.run_leaves += seg.run_leaves;
+    }
   } else {
     report.samples_per_segment = sampled_test_size(params.epsilon, params.delta);
     RobotState state(scene);

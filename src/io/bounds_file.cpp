@@ -69,6 +69,7 @@ nlohmann::json safety_json(const Scene& scene, const SafetyReport& report, const
       j["max_depth"] = s.max_depth;
       // Only when it happened: the key is new, and older files never ran out this way.
       if (s.budget_exhausted) j["budget_exhausted"] = true;
+      if (s.run) j["run"] = true;
     } else {
       j["samples"] = s.samples;
       j["rounds"] = s.rounds;
@@ -99,6 +100,10 @@ nlohmann::json safety_json(const Scene& scene, const SafetyReport& report, const
                    {"ran", report.grow.ran},
                    {"grown", report.grow.grown},
                    {"leaves", report.grow.stats.leaves}};
+    // Dense paths: the runs of short segments proven at once (docs/algorithm.md, "Dense paths");
+    // their leaves are in `leaves` above too.
+    out["runs"] = {
+        {"enabled", params.runs}, {"segments", report.run_segments}, {"leaves", report.run_leaves}};
   } else if (report.mode == SafetyMode::kSampled) {
     out["passed"] = report.all_passed;
     out["epsilon"] = params.epsilon;

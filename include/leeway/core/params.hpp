@@ -132,6 +132,10 @@ struct SafetyParams {
   //! "lever" (one pass, the joint whose kept share costs the tool least motion first, each side
   //! straight to its target).
   std::string shape = "greedy";
+  //! Certified mode, dense paths: first prove runs of up to 16 short segments at once, one box
+  //! holding their waypoints' guide boxes (docs/algorithm.md, "Dense paths"); false: every segment
+  //! is proven on its own, as before.
+  bool runs = true;
 };
 
 //! All parameters.

@@ -27,6 +27,10 @@ struct SegmentSafety {
   //! proven, it is not certified and keeps its nominal values; after (while regrowing), it keeps
   //! the bounds proven so far, narrower than the search would have made them.
   bool budget_exhausted = false;
+  //! Certified mode, dense paths: proven by a run's box (docs/algorithm.md, "Dense paths": one
+  //! proof of a box holding this and the next segments), its own or an earlier segment's.
+  bool run = false;
+  long run_leaves = 0;  //!< leaves this segment spent on run boxes, proven or not (in `leaves` too)
 };
 
 //! The certified mode's work limit per segment, in multiples of SafetyParams::max_leaves: every
@@ -55,6 +59,8 @@ struct SafetyReport {
   long samples_per_segment = 0;  //!< sampled mode: N = ceil(ln(1/delta) / epsilon)
   double ms = 0;                 //!< wall time of the stage [ms]
   GrowReport grow;               //!< certified mode: the growth beyond the guide
+  int run_segments = 0;          //!< certified mode: segments proven by a run's box (SegmentSafety::run)
+  long run_leaves = 0;           //!< certified mode: leaves spent on run boxes (in `stats` too)
 };
 
 //! Samples one sampling round needs: N = ceil(ln(1/delta) / epsilon). Zero collisions in N uniform

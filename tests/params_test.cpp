@@ -82,6 +82,7 @@ Params unusual() {
   p.safety.grow = "j4,j6";
   p.safety.max_half_width = {{"j6", 0.25}};
   p.safety.shape = "lever";
+  p.safety.runs = false;
   p.cf.windows = 12;
   p.cf.samples = 500;
   p.cf.seed = 18446744073709551615ull;  // the largest seed: JSON must carry all 64 bits
@@ -119,6 +120,7 @@ void expect_equal(const Params& a, const Params& b) {
   EXPECT_EQ(a.safety.grow, b.safety.grow);
   EXPECT_EQ(a.safety.max_half_width, b.safety.max_half_width);
   EXPECT_EQ(a.safety.shape, b.safety.shape);
+  EXPECT_EQ(a.safety.runs, b.safety.runs);
   EXPECT_EQ(a.cf.windows, b.cf.windows);
   EXPECT_EQ(a.cf.samples, b.cf.samples);
   EXPECT_EQ(a.cf.seed, b.cf.seed);
@@ -143,7 +145,9 @@ TEST(ParamsJsonTest, KeysAreTheFieldNames) {
   EXPECT_EQ(j.at("bounds").at("linear_axis_tolerance"), 0.05);
   EXPECT_EQ(j.at("cf").at("seed"), 18446744073709551615ull);
   EXPECT_EQ(j.size(), 6u);
-  EXPECT_EQ(j.at("safety").size(), 9u);
+  EXPECT_EQ(j.at("safety").size(), 10u);
+  EXPECT_EQ(j.at("safety").at("runs"), false);
+  EXPECT_EQ(to_json(Params{}).at("safety").at("runs"), true);
   EXPECT_EQ(j.at("safety").at("mode"), "certified");
   EXPECT_EQ(j.at("safety").at("shape"), "lever");
   EXPECT_EQ(to_json(Params{}).at("safety").at("shape"), "greedy");

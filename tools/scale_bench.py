@@ -107,6 +107,8 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         folder = pathlib.Path(tmp)
         cases = args.path_case or DEFAULT_CASES
+        off = folder / "runs_off.json"  # --compare-runs: the parameters without run boxes
+        off.write_text(json.dumps({"safety": {"runs": False}}))
         paths = [] if args.only == "check" else [tuple(c.split(":")) for c in cases]
         for name, a, b in paths:
             cell = ROOT / "mjcf" / "workcells" / f"{name}.xml"
@@ -127,8 +129,6 @@ def main():
                     f"self-collisions in {cf['samples']} samples")
             rows.append((f"bounds {name} {a}-{b} --path ({args.waypoints} waypoints)", runs, 30.0, note))
             if args.compare_runs:
-                off = folder / "runs_off.json"
-                off.write_text(json.dumps({"safety": {"runs": False}}))
                 out_off = folder / "bounds_off.json"
                 run_off = timed([LEEWAY, "bounds", str(cell), "--path", str(p), "--params", str(off),
                                  "--out", str(out_off)])
@@ -158,13 +158,15 @@ def main():
                   "| path | wall [s]: runs / without | CPU [s]: runs / without | leaves: runs / without | "
                   "segments proven by run boxes | width per joint [%] |",
                   "|---|---:|---:|---:|---:|---|"]
+        def mean_width(doc, i):
+            return statistics.mean(w["upper"][i] - w["lower"][i] for w in doc["waypoints"])
+
         for case, (wall, cpu, d), (wall_off, cpu_off, d_off) in compared:
-            joints = d["joints"]
-            def mean_width(doc, i):
-                return statistics.mean(w["upper"][i] - w["lower"][i] for w in doc["waypoints"])
-            shares = ", ".join(
-                f"{name} {100 * mean_width(d, i) / mean_width(d_off, i):.1f}" if mean_width(d_off, i) > 0
-                else f"{name} -" for i, name in enumerate(joints))
+            shares = []
+            for i, name in enumerate(d["joints"]):
+                base = mean_width(d_off, i)
+                shares.append(f"{name} {100 * mean_width(d, i) / base:.1f}" if base > 0 else f"{name} -")
+            shares = ", ".join(shares)
             s, s_off = d["safety"], d_off["safety"]
             lines.append(f"| {case} | {wall:.2f} / {wall_off:.2f} | {cpu:.2f} / {cpu_off:.2f} | "
                          f"{s['leaves']} / {s_off['leaves']} | {s['runs']['segments']} of {len(s['segments'])} | "

@@ -103,7 +103,7 @@ struct RunBox {
   Eigen::VectorXd lower, upper;
   bool proven = false;
   int failures = 0;
-  std::vector<char> refused;  // [2 i + side]
+  std::vector<char> refused;  // [2 i + side], sized by make_safe
 };
 
 // Which neighbouring segments share the segment's waypoints and ran before it (a regrown waypoint
@@ -198,11 +198,17 @@ class SegmentRepair {
     }
   }
 
+  // The box of segment (from, to) at the extents set: the hull of its two ends' boxes, which holds
+  // its box at every t.
+  std::pair<Eigen::VectorXd, Eigen::VectorXd> segment_box(size_t from, size_t to) const {
+    return {e_.lower(from).cwiseMin(e_.lower(to)), e_.upper(from).cwiseMax(e_.upper(to))};
+  }
+
   // Whether the run's box is proven and holds the box of segment (from, to) at the extents set.
   bool run_box_holds(size_t from, size_t to) const {
     if (!run_ || !run_->proven) return false;
-    return (run_->lower.array() <= e_.lower(from).cwiseMin(e_.lower(to)).array()).all() &&
-           (e_.upper(from).cwiseMax(e_.upper(to)).array() <= run_->upper.array()).all();
+    const auto [lower, upper] = segment_box(from, to);
+    return (run_->lower.array() <= lower.array()).all() && (upper.array() <= run_->upper.array()).all();
   }
 
   // The run's box: whether it holds this segment's box, proving a new one first when it does not
@@ -214,12 +220,10 @@ class SegmentRepair {
     if (!run_) return false;
     if (run_box_holds(a_, b_)) return true;
     if (run_->failures >= kMaxRunFailures) return false;
-    const Eigen::VectorXd lower = e_.lower(a_).cwiseMin(e_.lower(b_)),
-                          upper = e_.upper(a_).cwiseMax(e_.upper(b_));
+    auto [box_lower, box_upper] = segment_box(a_, b_);
     const size_t last = std::min(a_ + kRunWaypoints, e_.q.size() - 1);
     CertifyBudget budget = budget_;
     budget.max_leaves = std::max(64L, budget_.max_leaves / kRunBudgetDivisor);
-    Eigen::VectorXd box_lower = lower, box_upper = upper;
     for (size_t k = b_ + 1; k <= last; ++k) {
       box_lower = box_lower.cwiseMin(e_.q[k]);
       box_upper = box_upper.cwiseMax(e_.q[k]);
@@ -349,7 +353,6 @@ class SegmentRepair {
     const bool previous = nb_.check_previous && k == a_, next = nb_.check_next && k == b_ && a_ != b_;
     // A widening the chain was refused before is not tried again (RunBox).
     const bool widening = widen_b_ && s_.shrink_steps == 0 && run_;
-    if (widening) run_->refused.resize(static_cast<size_t>(2 * n_), 0);
     if (widening && run_->refused[static_cast<size_t>(2 * i + side)]) return;
     // Inside the run's box the whole way back needs no proof (nor a probe) ...
     extent = guide_extent;
@@ -505,7 +508,9 @@ SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, 
     // those of phase 0 then has a settled neighbour to start warm from.
     const size_t phases = dense ? kDensePhases : 3;
     // One run box per chain of warm starts (the segments of one chain run one after another).
-    std::vector<RunBox> runs(dense && params.runs ? segments / phases + 1 : 0);
+    RunBox fresh;
+    fresh.refused.assign(static_cast<size_t>(2 * scene.dof()), 0);
+    std::vector<RunBox> runs(dense && params.runs ? segments / phases + 1 : 0, fresh);
     for (size_t phase = 0; phase < phases; ++phase) {
       std::vector<size_t> jobs;
       for (size_t s = phase; s < segments; s += phases) jobs.push_back(s);

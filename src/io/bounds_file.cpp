@@ -100,7 +100,7 @@ nlohmann::json safety_json(const Scene& scene, const SafetyReport& report, const
                    {"ran", report.grow.ran},
                    {"grown", report.grow.grown},
                    {"leaves", report.grow.stats.leaves}};
-    // Dense paths: the runs of short segments proven at once (docs/algorithm.md, "Dense paths");
+    // Dense paths: the segments proven by run boxes (docs/algorithm.md, "Run boxes");
     // their leaves are in `leaves` above too.
     out["runs"] = {
         {"enabled", params.runs}, {"segments", report.run_segments}, {"leaves", report.run_leaves}};

@@ -132,9 +132,10 @@ struct SafetyParams {
   //! "lever" (one pass, the joint whose kept share costs the tool least motion first, each side
   //! straight to its target).
   std::string shape = "greedy";
-  //! Certified mode, dense paths: first prove runs of up to 16 short segments at once, one box
-  //! holding their waypoints' guide boxes (docs/algorithm.md, "Dense paths"); false: every segment
-  //! is proven on its own, as before.
+  //! Certified mode, dense paths: a warm segment inside its chain's run box (one proven box for up
+  //! to 16 waypoints ahead) needs no proof of its own, and a chain does not retry a widening the
+  //! certificate refused (docs/algorithm.md, "Run boxes"); false: every segment is proven on its
+  //! own, as before.
   bool runs = true;
 };
 

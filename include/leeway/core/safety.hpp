@@ -27,8 +27,8 @@ struct SegmentSafety {
   //! proven, it is not certified and keeps its nominal values; after (while regrowing), it keeps
   //! the bounds proven so far, narrower than the search would have made them.
   bool budget_exhausted = false;
-  //! Certified mode, dense paths: proven by a run's box (docs/algorithm.md, "Dense paths": one
-  //! proof of a box holding this and the next segments), its own or an earlier segment's.
+  //! Certified mode, dense paths: proven by its chain's run box (docs/algorithm.md, "Run boxes":
+  //! one proof of a box holding this and the next segments), its own or an earlier segment's.
   bool run = false;
   long run_leaves = 0;  //!< leaves this segment spent on run boxes, proven or not (in `leaves` too)
 };

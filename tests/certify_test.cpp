@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <iostream>
+#include <limits>
 #include <random>
 #include <sstream>
 #include <string>
@@ -608,6 +609,53 @@ const std::string kRailCell =
 // The same stop as a plane through x = 1 facing the carriage (normal -x): the half-space x >= 1.
 const std::string kRailPlaneCell =
     rail_cell(R"(<geom name="stop" type="plane" size="1 1 0.1" pos="1 0 0.5" zaxis="-1 0 0"/>)");
+
+// A slab's probe (segment_probe with grown_joint) checks only the pairs the grown joint moves. A
+// two-link arm (j1 at the origin, 1 m link 1 along x; j2 at its tip, 0.5 m link 2) and a post over
+// x, y in [0.3, 0.6]. At j1 = 0.6 rad link 1's upper edge passes (0.5 cos 0.6 - 0.05 sin 0.6,
+// 0.5 sin 0.6 + 0.05 cos 0.6) = (0.385, 0.323), inside the post; link 2 starts at its tip
+// (0.825, 0.565): pointing along x (j2 = -0.6 +- 0.1) it stays at x >= 0.82, clear of the post, and
+// folded back (j2 = 2.45 .. 2.5, pointing at 3.05 .. 3.1 rad) it runs to (0.33, 0.61 .. 0.59)
+// through the post.
+TEST_F(CertifyTest, SlabProbesCheckOnlyThePairsTheGrownJointMoves) {
+  test::TempDir dir;
+  const Scene scene = Scene::load(dir.write("cell.xml", R"(<mujoco model="two-link-post">
+  <compiler angle="radian" autolimits="true"/>
+  <worldbody>
+    <body name="link1" pos="0 0 0.5">
+      <joint name="j1" type="hinge" axis="0 0 1" range="-2.5 2.5"/>
+      <geom name="link1_box" type="box" size="0.5 0.05 0.05" pos="0.5 0 0"/>
+      <body name="link2" pos="1 0 0">
+        <joint name="j2" type="hinge" axis="0 0 1" range="-2.5 2.5"/>
+        <geom name="link2_box" type="box" size="0.25 0.05 0.05" pos="0.25 0 0"/>
+        <site name="tool0" pos="0.5 0 0"/>
+      </body>
+    </body>
+    <geom name="post" type="box" size="0.15 0.15 1" pos="0.45 0.45 0.5"/>
+  </worldbody>
+</mujoco>
+)"));
+  RobotState state(scene);
+  Certifier certifier(scene, CertifyOptions{});
+  CertifyContext ctx(scene);
+  CertifyStats stats;
+  auto v2 = [](double a, double b) { return (Eigen::VectorXd(2) << a, b).finished(); };
+  const Eigen::VectorXd along_lo = v2(0.6, -0.7), along_hi = v2(0.6, -0.5);
+  ASSERT_TRUE(state.in_collision(v2(0.6, -0.6)));
+  EXPECT_FALSE(
+      certifier.segment_probe(ctx, along_lo, along_hi, along_lo, along_hi, along_lo, along_lo, 16, stats));
+  EXPECT_TRUE(certifier.segment_probe(ctx, along_lo, along_hi, along_lo, along_hi, along_lo, along_lo, 16,
+                                      stats, nullptr, std::numeric_limits<long>::max(), 1));
+  const Eigen::VectorXd folded_lo = v2(0.6, 2.45), folded_hi = v2(0.6, 2.5);
+  EXPECT_FALSE(certifier.segment_probe(ctx, folded_lo, folded_hi, folded_lo, folded_hi, folded_lo, folded_lo,
+                                       16, stats, nullptr, std::numeric_limits<long>::max(), 1));
+  // Joint j1 moves every pair: its slab's probe is the whole probe.
+  EXPECT_FALSE(certifier.segment_probe(ctx, along_lo, along_hi, along_lo, along_hi, along_lo, along_lo, 16,
+                                       stats, nullptr, std::numeric_limits<long>::max(), 0));
+  EXPECT_THROW(certifier.segment_probe(ctx, along_lo, along_hi, along_lo, along_hi, along_lo, along_lo, 16,
+                                       stats, nullptr, std::numeric_limits<long>::max(), 2),
+               InputError);
+}
 
 TEST_F(CertifyTest, SlideCertifiedUpToThePlateMinusTheMargin) {
   test::TempDir dir;

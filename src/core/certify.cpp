@@ -377,7 +377,7 @@ bool Certifier::region_free_impl(CertifyContext& ctx, const Eigen::VectorXd& low
 
 bool Certifier::probe(CertifyContext& ctx, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
                       const Eigen::VectorXd& nominal, long leaf_limit, CertifyStats& stats,
-                      CertifyFailure* failure) const {
+                      CertifyFailure* failure, const std::vector<int>* checked) const {
   const int n = static_cast<int>(lower.size());
   std::vector<int> moving;
   for (int i = 0; i < n; ++i)
@@ -400,7 +400,7 @@ bool Certifier::probe(CertifyContext& ctx, const Eigen::VectorXd& lower, const E
         p[moving[m]] = (bits >> m) & 1 ? upper[moving[m]] : lower[moving[m]];
     }
     if (stats.leaves >= leaf_limit) return out_of_leaves(lower, upper, failure);
-    std::vector<int> pairs = all_pairs_;
+    std::vector<int> pairs = checked ? *checked : all_pairs_;
     const Eigen::VectorXd offsets = (p - nominal).cwiseAbs();
     if (leaf_free_impl(ctx, p, p, pairs, stats, &local, &offsets)) continue;
     local.centre_hits = true;
@@ -414,16 +414,19 @@ bool Certifier::segment_probe(CertifyContext& ctx, const Eigen::VectorXd& lower_
                               const Eigen::VectorXd& upper_a, const Eigen::VectorXd& lower_b,
                               const Eigen::VectorXd& upper_b, const Eigen::VectorXd& qa,
                               const Eigen::VectorXd& qb, int samples, CertifyStats& stats,
-                              CertifyFailure* failure, long leaf_limit) const {
+                              CertifyFailure* failure, long leaf_limit, int grown_joint) const {
   check_context(ctx);
   check_box(*scene_, qa, qa);
   check_box(*scene_, qb, qb);
   check_box(*scene_, lower_a, upper_a);
   check_box(*scene_, lower_b, upper_b);
+  if (grown_joint >= scene_->dof()) throw InputError("certify: no joint " + std::to_string(grown_joint));
+  const std::vector<int>& pairs =
+      grown_joint < 0 ? all_pairs_ : pairs_moved_by_[static_cast<size_t>(grown_joint)];
   CertifyFailure local;
   for (double t : {0.0, 1.0, 0.5, 0.25, 0.75}) {
     if (probe(ctx, (1 - t) * lower_a + t * lower_b, (1 - t) * upper_a + t * upper_b, (1 - t) * qa + t * qb,
-              leaf_limit, stats, &local))
+              leaf_limit, stats, &local, &pairs))
       continue;
     local.t0 = local.t1 = t;
     if (failure) *failure = local;
@@ -441,7 +444,7 @@ bool Certifier::segment_probe(CertifyContext& ctx, const Eigen::VectorXd& lower_
     const Eigen::VectorXd lo = (1 - t) * lower_a + t * lower_b, hi = (1 - t) * upper_a + t * upper_b;
     for (int i = 0; i < n; ++i) p[i] = lo[i] + (hi[i] - lo[i]) * unit();
     const Eigen::VectorXd nominal = (1 - t) * qa + t * qb;
-    if (probe(ctx, p, p, nominal, leaf_limit, stats, &local)) continue;
+    if (probe(ctx, p, p, nominal, leaf_limit, stats, &local, &pairs)) continue;
     local.t0 = local.t1 = t;
     if (failure) *failure = local;
     return false;

@@ -303,29 +303,51 @@ class SegmentRepair {
   // (p, r), k one of its ends, exactly the configurations whose joint i lies between the old and the
   // new bound: at each t a box, linear in t between the two ends (at the end other than k the
   // slab has zero width). That slab is itself a segment for the certificate, and a thin one.
-  bool slab_certified(size_t p, size_t r, size_t k, int i, int side, double from, double to,
-                      long budget_divisor) {
-    std::vector<Eigen::VectorXd> lo = {e_.lower(p), e_.lower(r)}, hi = {e_.upper(p), e_.upper(r)};
+  struct Slab {
+    Eigen::VectorXd lower[2], upper[2];  // at the segment's two ends
+  };
+  Slab slab(size_t p, size_t r, size_t k, int i, int side, double from, double to) const {
+    Slab slab{{e_.lower(p), e_.lower(r)}, {e_.upper(p), e_.upper(r)}};
     for (size_t end = 0; end < 2; ++end) {
       const size_t x = end ? r : p;
       const double now = side ? e_.above[x][i] : e_.below[x][i];
       const double old_extent = x == k ? from : now, new_extent = x == k ? to : now;
       if (side) {
-        lo[end][i] = e_.q[x][i] + old_extent;
-        hi[end][i] = e_.q[x][i] + new_extent;
+        slab.lower[end][i] = e_.q[x][i] + old_extent;
+        slab.upper[end][i] = e_.q[x][i] + new_extent;
       } else {
-        lo[end][i] = e_.q[x][i] - new_extent;
-        hi[end][i] = e_.q[x][i] - old_extent;
+        slab.lower[end][i] = e_.q[x][i] - new_extent;
+        slab.upper[end][i] = e_.q[x][i] - old_extent;
       }
     }
+    return slab;
+  }
+
+  // Whether the segment (p, r) that shares waypoint k was certified before this step: then a slab
+  // of it needs only the pairs joint i moves (Certifier::segment_free); else every pair.
+  bool region_certified(size_t p, size_t r) const {
+    return (p == a_ && r == b_) || (p < a_ ? nb_.previous_certified : nb_.next_certified);
+  }
+
+  bool slab_certified(size_t p, size_t r, size_t k, int i, int side, double from, double to,
+                      long budget_divisor) {
+    const Slab s = slab(p, r, k, i, side, from, to);
     CertifyBudget thin = budget_;
     thin.max_leaves = std::max(64L, budget_.max_leaves / budget_divisor);
-    // On a certified segment only the pairs joint i moves need a proof: the others stay apart over
-    // the slab (Certifier::segment_free). On a neighbour that was not certified, every pair.
-    const bool region_certified =
-        (p == a_ && r == b_) || (p < a_ ? nb_.previous_certified : nb_.next_certified);
-    return certifier_.segment_free(ctx_, lo[0], hi[0], lo[1], hi[1], thin, stats_, nullptr, nullptr,
-                                   region_certified ? i : -1);
+    return certifier_.segment_free(ctx_, s.lower[0], s.upper[0], s.lower[1], s.upper[1], thin, stats_,
+                                   nullptr, nullptr, region_certified(p, r) ? i : -1);
+  }
+
+  // The probe of the slab's outer face (joint i at the new extent at waypoint k, at its bound at the
+  // other end): the rest of the segment was proven free with the old extent, so only configurations
+  // the growth adds need checking, and where it hits, it hits first at its outer face in most cases
+  // (the certificate still proves the whole slab). Half the corners of the segment's probe, and only
+  // the pairs joint i moves.
+  bool face_probed(size_t p, size_t r, size_t k, int i, int side, double to) {
+    const Slab s = slab(p, r, k, i, side, to, to);
+    return certifier_.segment_probe(ctx_, s.lower[0], s.upper[0], s.lower[1], s.upper[1], e_.q[p], e_.q[r],
+                                    kProbeSamples, stats_, nullptr, budget_.leaf_limit,
+                                    region_certified(p, r) ? i : -1);
   }
 
   void regrow() {
@@ -338,9 +360,18 @@ class SegmentRepair {
         for (int side = 0; side < 2 && !out_of_budget(); ++side) regrow_extent(k, i, side);
   }
 
-  // The probe of this segment and of the neighbours that share waypoint k, at the extents set.
-  bool probe_all(size_t k) {
+  // The probe of this segment and of the neighbours that share waypoint k, at the extents set (joint
+  // i's extent on `side` at k being the one regrown from `from`). On a short segment, only the faces
+  // of the slabs the growth adds (face_probed): a dense path regrows hundreds of segments, and
+  // probing each whole segment again repeats checks of what is already proven.
+  bool probe_all(size_t k, int i, int side, double from) {
     const bool previous = nb_.check_previous && k == a_, next = nb_.check_next && k == b_ && a_ != b_;
+    if (short_) {
+      const double to = side ? e_.above[k][i] : e_.below[k][i];
+      if (!(to > from)) return true;
+      return face_probed(a_, b_, k, i, side, to) && (!previous || face_probed(a_ - 1, a_, k, i, side, to)) &&
+             (!next || face_probed(b_, b_ + 1, k, i, side, to));
+    }
     return probed(a_, b_, nullptr) && (!previous || probed(a_ - 1, a_, nullptr)) &&
            (!next || probed(b_, b_ + 1, nullptr));
   }
@@ -361,12 +392,12 @@ class SegmentRepair {
       return;
     // ... else the largest extent the probe does not reject, by bisection (cheap) ...
     double ok = shrunk_to, bad = guide_extent;
-    if (probe_all(k)) {
+    if (probe_all(k, i, side, shrunk_to)) {
       ok = bad;
     } else {
       for (int step = 0; step < kProbeSteps; ++step) {
         extent = (ok + bad) / 2;
-        const bool pass = probe_all(k);
+        const bool pass = probe_all(k, i, side, shrunk_to);
         (pass ? ok : bad) = extent;
       }
     }

@@ -128,12 +128,14 @@ class Certifier {
   //! segment (a fixed, seeded sequence). False, with `failure` at the first configuration that comes
   //! within the margin of an obstacle (centre_hits set, t0 = t1 = its path parameter, split_joint =
   //! the joint whose offset from the nominal value qa..qb moves the failing link most). Each check
-  //! counts a leaf against `leaf_limit`.
+  //! counts a leaf against `leaf_limit`. `grown_joint` (>= 0): the bounds are (a part of) a slab
+  //! that grows a certified region in this joint only, as in segment_free, and only the pairs it
+  //! moves are checked.
   bool segment_probe(CertifyContext& ctx, const Eigen::VectorXd& lower_a, const Eigen::VectorXd& upper_a,
                      const Eigen::VectorXd& lower_b, const Eigen::VectorXd& upper_b,
                      const Eigen::VectorXd& qa, const Eigen::VectorXd& qb, int samples, CertifyStats& stats,
-                     CertifyFailure* failure = nullptr,
-                     long leaf_limit = std::numeric_limits<long>::max()) const;
+                     CertifyFailure* failure = nullptr, long leaf_limit = std::numeric_limits<long>::max(),
+                     int grown_joint = -1) const;
 
   //! One leaf, no subdivision: true when the bound proves the box free.
   bool leaf_free(CertifyContext& ctx, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
@@ -178,10 +180,11 @@ class Certifier {
                         const std::vector<int>& pairs) const;
   //! Exact tests of the box's centre and corners (random points when there are more than 256
   //! corners): false, with `failure` at the first point within the margin of an obstacle, when one
-  //! is. Such a region can never be certified, however finely it is split.
+  //! is. Such a region can never be certified, however finely it is split. `checked`: the pairs
+  //! tested (null: all).
   bool probe(CertifyContext& ctx, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
-             const Eigen::VectorXd& nominal, long leaf_limit, CertifyStats& stats,
-             CertifyFailure* failure) const;
+             const Eigen::VectorXd& nominal, long leaf_limit, CertifyStats& stats, CertifyFailure* failure,
+             const std::vector<int>* checked = nullptr) const;
   void check_context(const CertifyContext& ctx) const;
 
   const Scene* scene_;

@@ -365,15 +365,21 @@ class SegmentRepair {
   // of the slabs the growth adds (face_probed): a dense path regrows hundreds of segments, and
   // probing each whole segment again repeats checks of what is already proven.
   bool probe_all(size_t k, int i, int side, double from) {
-    const bool previous = nb_.check_previous && k == a_, next = nb_.check_next && k == b_ && a_ != b_;
     if (short_) {
       const double to = side ? e_.above[k][i] : e_.below[k][i];
       if (!(to > from)) return true;
-      return face_probed(a_, b_, k, i, side, to) && (!previous || face_probed(a_ - 1, a_, k, i, side, to)) &&
-             (!next || face_probed(b_, b_ + 1, k, i, side, to));
+      return all_at(k, [&](size_t p, size_t r) { return face_probed(p, r, k, i, side, to); });
     }
-    return probed(a_, b_, nullptr) && (!previous || probed(a_ - 1, a_, nullptr)) &&
-           (!next || probed(b_, b_ + 1, nullptr));
+    return all_at(k, [&](size_t p, size_t r) { return probed(p, r, nullptr); });
+  }
+
+  // Whether `test` holds for this segment and for the neighbours that share waypoint k and ran
+  // before it (a regrown waypoint must keep them certified), in that order, stopping at the first
+  // that fails.
+  template <class Test>
+  bool all_at(size_t k, Test test) {
+    const bool previous = nb_.check_previous && k == a_, next = nb_.check_next && k == b_ && a_ != b_;
+    return test(a_, b_) && (!previous || test(a_ - 1, a_)) && (!next || test(b_, b_ + 1));
   }
 
   void regrow_extent(size_t k, int i, int side) {
@@ -381,15 +387,12 @@ class SegmentRepair {
     const size_t end = k == b_ ? 1 : 0;
     const double shrunk_to = extent, guide_extent = side ? target_above_[end][i] : target_below_[end][i];
     if (!(guide_extent > shrunk_to)) return;
-    const bool previous = nb_.check_previous && k == a_, next = nb_.check_next && k == b_ && a_ != b_;
     // A widening the chain was refused before is not tried again (RunBox).
     const bool widening = widen_b_ && s_.shrink_steps == 0 && run_;
     if (widening && run_->refused[static_cast<size_t>(2 * i + side)]) return;
     // Inside the run's box the whole way back needs no proof (nor a probe) ...
     extent = guide_extent;
-    if (run_box_holds(a_, b_) && (!previous || run_box_holds(a_ - 1, a_)) &&
-        (!next || run_box_holds(b_, b_ + 1)))
-      return;
+    if (all_at(k, [&](size_t p, size_t r) { return run_box_holds(p, r); })) return;
     // ... else the largest extent the probe does not reject, by bisection (cheap) ...
     double ok = shrunk_to, bad = guide_extent;
     if (probe_all(k, i, side, shrunk_to)) {
@@ -414,9 +417,8 @@ class SegmentRepair {
       extent = step == limit_step ? bad : step == thin_step ? ok + (bad - ok) / 8 : (ok + bad) / 2;
       const long divisor = short_ && step == thin_step ? kThinSlabBudgetDivisor : kSlabBudgetDivisor;
       // Only what the growth adds needs proving: the rest was proven with extent `ok`.
-      const bool pass = slab_certified(a_, b_, k, i, side, ok, extent, divisor) &&
-                        (!previous || slab_certified(a_ - 1, a_, k, i, side, ok, extent, divisor)) &&
-                        (!next || slab_certified(b_, b_ + 1, k, i, side, ok, extent, divisor));
+      const bool pass = all_at(
+          k, [&](size_t p, size_t r) { return slab_certified(p, r, k, i, side, ok, extent, divisor); });
       if (pass) {
         ok = extent;
         if (step == limit_step) break;

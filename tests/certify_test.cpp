@@ -657,6 +657,47 @@ TEST_F(CertifyTest, SlabProbesCheckOnlyThePairsTheGrownJointMoves) {
                InputError);
 }
 
+// The box probe of dense-path growth, on the same arm and post: its corners are checked (a box
+// whose centre is free but whose corner j1 = 0.6 is in the post fails), and with grown_joint only
+// the pairs that joint moves (link 2's).
+TEST_F(CertifyTest, BoxProbesCheckTheCornersAndOnlyThePairsTheGrownJointMoves) {
+  test::TempDir dir;
+  const Scene scene = Scene::load(dir.write("cell.xml", R"(<mujoco model="two-link-post">
+  <compiler angle="radian" autolimits="true"/>
+  <worldbody>
+    <body name="link1" pos="0 0 0.5">
+      <joint name="j1" type="hinge" axis="0 0 1" range="-2.5 2.5"/>
+      <geom name="link1_box" type="box" size="0.5 0.05 0.05" pos="0.5 0 0"/>
+      <body name="link2" pos="1 0 0">
+        <joint name="j2" type="hinge" axis="0 0 1" range="-2.5 2.5"/>
+        <geom name="link2_box" type="box" size="0.25 0.05 0.05" pos="0.25 0 0"/>
+        <site name="tool0" pos="0.5 0 0"/>
+      </body>
+    </body>
+    <geom name="post" type="box" size="0.15 0.15 1" pos="0.45 0.45 0.5"/>
+  </worldbody>
+</mujoco>
+)"));
+  RobotState state(scene);
+  Certifier certifier(scene, CertifyOptions{});
+  CertifyContext ctx(scene);
+  CertifyStats stats;
+  auto v2 = [](double a, double b) { return (Eigen::VectorXd(2) << a, b).finished(); };
+  // j1 in [0, 0.6]: at its centre 0.3 link 1's edge stays below y = 0.3 where x <= 0.6 (free).
+  const Eigen::VectorXd wide_lo = v2(0.0, -0.7), wide_hi = v2(0.6, -0.5);
+  ASSERT_FALSE(state.in_collision(v2(0.3, -0.6)));
+  EXPECT_FALSE(certifier.box_probe(ctx, wide_lo, wide_hi, stats));
+  EXPECT_TRUE(certifier.box_probe(ctx, v2(0.0, -0.7), v2(0.3, -0.5), stats));
+  const Eigen::VectorXd along_lo = v2(0.6, -0.7), along_hi = v2(0.6, -0.5);
+  EXPECT_TRUE(certifier.box_probe(ctx, along_lo, along_hi, stats, std::numeric_limits<long>::max(), 1));
+  EXPECT_FALSE(
+      certifier.box_probe(ctx, v2(0.6, 2.45), v2(0.6, 2.5), stats, std::numeric_limits<long>::max(), 1));
+  // Each check counts a leaf against the limit: none left, no answer but "not free".
+  EXPECT_FALSE(certifier.box_probe(ctx, v2(0.0, -0.7), v2(0.3, -0.5), stats, stats.leaves));
+  EXPECT_THROW(certifier.box_probe(ctx, along_lo, along_hi, stats, std::numeric_limits<long>::max(), 2),
+               InputError);
+}
+
 TEST_F(CertifyTest, SlideCertifiedUpToThePlateMinusTheMargin) {
   test::TempDir dir;
   for (const auto& [text, name] :

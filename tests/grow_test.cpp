@@ -247,6 +247,107 @@ TEST_F(GrowTest, RunBoxesOfADenseTwoLinkPathNearTheWallAreFree) {
   EXPECT_GT(width, 0.95 * width_off);
 }
 
+// A dense path (steps of 5 mrad, guide +-0.1 rad: every segment short) grows by blocks of 16
+// segments, each block's waypoints to one extent, its hull proven. One-link arm toward the wall:
+// nothing is on the -y side, so every waypoint reaches the joint's lower limit -3; on the
+// wall's side the hull of each block stops within 1 mm of the wall, so the block's furthest
+// waypoint comes within 5 mrad of the touch angle less the margin, and none goes beyond it.
+TEST_F(GrowTest, DenseOneLinkPathGrowsByBlocksToTheWallLessTheMargin) {
+  const Scene scene = Scene::load(dir_.write("one_link.xml", test::one_link_cell(kWall)));
+  std::vector<WaypointBounds> b;
+  for (int k = 0; k <= 60; ++k)
+    b.push_back(box(v1(0.8 + 0.005 * k), v1(0.7 + 0.005 * k), v1(0.9 + 0.005 * k)));
+  const SafetyReport r = make_safe(scene, b, SafetyParams{});
+  ASSERT_TRUE(r.all_passed);
+  ASSERT_TRUE(r.grow.ran);
+  EXPECT_GT(r.run_segments, 0);  // a dense path: its warm segments run in chains
+  const double limit = kTouch - kWithinMargin;
+  for (size_t k = 0; k < b.size(); ++k) {
+    SCOPED_TRACE(k);
+    EXPECT_NEAR(b[k].lower[0], -3.0, 1e-9);
+    EXPECT_LE(b[k].upper[0], limit + 1e-9);
+  }
+  for (size_t first = 0; first + 1 < b.size(); first += 16) {
+    SCOPED_TRACE(first);
+    double furthest = -INFINITY;
+    for (size_t k = first; k <= std::min(first + 16, b.size() - 1); ++k)
+      furthest = std::max(furthest, b[k].upper[0]);
+    EXPECT_GE(furthest, limit - 0.005);
+  }
+  EXPECT_GE(sampled_clearance(scene, b, 2000), 0.001 - 1e-9);
+}
+
+// The dense two-link path through the wall of the run-box test below, grown: both joints widen
+// beyond the certified bounds somewhere, every certified interval is kept (growth never narrows),
+// the result is free with the margin between the waypoints too (1 mm over the corners and 2,000
+// samples per segment), and it is the same for one thread and two.
+TEST_F(GrowTest, DenseTwoLinkPathNearTheWallGrowsAndStaysFree) {
+  const Scene scene = Scene::load(dir_.write("two_link.xml", kTwoLink));
+  std::vector<WaypointBounds> b;
+  for (int k = 0; k <= 80; ++k) {
+    const Eigen::VectorXd q = v2(-0.3 + 0.0025 * k, 0.5 + 0.0025 * k);
+    b.push_back(box(q, q - v2(0.1, 0.3), q + v2(0.1, 0.8)));
+  }
+  std::vector<WaypointBounds> two_threads = b, certified = b;
+  SafetyParams params;
+  const SafetyReport r = make_safe(scene, b, params, 1);
+  make_safe(scene, two_threads, params, 2);
+  params.grow = "none";
+  make_safe(scene, certified, params, 1);
+  ASSERT_TRUE(r.all_passed);
+  EXPECT_GT(r.grow.grown, 40);
+  int wider[2] = {0, 0};
+  for (size_t k = 0; k < b.size(); ++k) {
+    SCOPED_TRACE(k);
+    EXPECT_EQ(b[k].lower, two_threads[k].lower);
+    EXPECT_EQ(b[k].upper, two_threads[k].upper);
+    for (int i = 0; i < 2; ++i) {
+      EXPECT_LE(b[k].lower[i], certified[k].lower[i]);
+      EXPECT_GE(b[k].upper[i], certified[k].upper[i]);
+      wider[i] += b[k].upper[i] - b[k].lower[i] > certified[k].upper[i] - certified[k].lower[i] + 0.01;
+    }
+  }
+  EXPECT_GT(wider[0], 10);
+  EXPECT_GT(wider[1], 10);
+  EXPECT_GE(sampled_clearance(scene, b, 2000), 0.001 - 1e-9);
+}
+
+// Blocks share their end waypoints: an even block grows its ends first, and when the odd block
+// beside it cannot grow, those ends must go back to the bounds its segments were certified with.
+// One-link arm, 49 waypoints at 1.055 + 0.15 sin(pi k / 48) rad (steps under 10 mrad, guide
+// +-0.1): the nominal path enters the wall (1.1995 rad) only inside block 1 (waypoints 16-32), so
+// some of its segments are not certified and it does not grow; blocks 0 and 2 grow to the lower
+// limit -3 inside, and waypoints 16 and 32 keep exactly their certified bounds.
+TEST_F(GrowTest, AnOddBlockThatCannotGrowGivesItsEndsBack) {
+  const Scene scene = Scene::load(dir_.write("one_link.xml", test::one_link_cell(kWall)));
+  std::vector<WaypointBounds> b;
+  for (int k = 0; k <= 48; ++k) {
+    const double q = 1.055 + 0.15 * std::sin(M_PI * k / 48);
+    b.push_back(box(v1(q), v1(q - 0.1), v1(q + 0.1)));
+  }
+  std::vector<WaypointBounds> certified = b;
+  const SafetyReport r = make_safe(scene, b, SafetyParams{});
+  SafetyParams none;
+  none.grow = "none";
+  make_safe(scene, certified, none);
+  ASSERT_TRUE(r.grow.ran);
+  bool block1_failed = false;
+  for (size_t s = 16; s < 32; ++s) block1_failed = block1_failed || !r.segments[s].passed;
+  ASSERT_TRUE(block1_failed);
+  for (size_t s : {size_t{0}, size_t{15}, size_t{32}, size_t{47}}) ASSERT_TRUE(r.segments[s].passed) << s;
+  for (size_t k : {size_t{1}, size_t{8}, size_t{15}, size_t{33}, size_t{40}, size_t{47}})
+    EXPECT_NEAR(b[k].lower[0], -3.0, 1e-9) << k;
+  for (size_t k = 16; k <= 32; ++k) {
+    SCOPED_TRACE(k);
+    EXPECT_EQ(b[k].lower[0], certified[k].lower[0]);
+    EXPECT_EQ(b[k].upper[0], certified[k].upper[0]);
+  }
+  // The certified blocks are free with the margin, their ends included.
+  const std::vector<WaypointBounds> block0(b.begin(), b.begin() + 17), block2(b.begin() + 32, b.end());
+  EXPECT_GE(sampled_clearance(scene, block0, 2000), 0.001 - 1e-9);
+  EXPECT_GE(sampled_clearance(scene, block2, 2000), 0.001 - 1e-9);
+}
+
 TEST_F(GrowTest, CapsNarrowAndNoneKeepsTheCertifiedBounds) {
   const Scene scene = Scene::load(dir_.write("one_link.xml", test::one_link_cell(kWall)));
   const std::vector<WaypointBounds> guide = {box(v1(0.0), v1(-0.4), v1(0.4)), box(v1(0.3), v1(0.2), v1(0.4))};

@@ -92,8 +92,10 @@ TEST_F(OneLinkSafetyTest, ADensePathIsCertifiedAsWideAsATwoWaypointOne) {
   std::vector<WaypointBounds> dense;
   for (int k = 0; k <= 60; ++k) dense.push_back(box_around(0.005 * k, -0.5, 2.0));
   std::vector<WaypointBounds> two_threads = dense;
-  const SafetyReport r = make_safe(*scene_, dense, SafetyParams{}, 1);
-  make_safe(*scene_, two_threads, SafetyParams{}, 2);
+  SafetyParams params;
+  params.grow = "none";  // the repair alone (growth by blocks: GrowTest)
+  const SafetyReport r = make_safe(*scene_, dense, params, 1);
+  make_safe(*scene_, two_threads, params, 2);
   ASSERT_EQ(r.segments.size(), 60u);
   EXPECT_TRUE(r.all_passed);
   EXPECT_GT(r.run_segments, 0);  // run boxes proved some segments (next to the wall)
@@ -120,8 +122,10 @@ TEST_F(OneLinkSafetyTest, ADensePathWidensAgainWhereItsGuideWidens) {
   }
   const std::vector<WaypointBounds> guide = dense;
   std::vector<WaypointBounds> two_threads = dense;
-  const SafetyReport r = make_safe(*scene_, dense, SafetyParams{}, 1);
-  make_safe(*scene_, two_threads, SafetyParams{}, 2);
+  SafetyParams params;
+  params.grow = "none";  // the repair alone (growth by blocks: GrowTest)
+  const SafetyReport r = make_safe(*scene_, dense, params, 1);
+  make_safe(*scene_, two_threads, params, 2);
   EXPECT_TRUE(r.all_passed);
   for (size_t k = 0; k < dense.size(); ++k) {
     SCOPED_TRACE(k);

@@ -13,11 +13,16 @@
 With --compare-runs, each path is also bounded once with `safety.runs` = false (every segment of
 the dense path proven on its own, as before run boxes; docs/algorithm.md, "Run boxes"), and a
 second table compares the two: wall and CPU time, leaves, and each joint's mean interval width.
+With --compare-grow, each path is also bounded once with `--grow none` (the certified bounds
+without growth by blocks; docs/algorithm.md, "Growing beyond the guide", step 7), and a table
+compares the two: wall and CPU time, the growth's leaves, and the room (the mean kept share of each
+joint's one-joint free range, leeway's room measure).
 
 Every input is generated into a temporary folder (nothing is written to the repository); each case
 runs --repeats times and the table gives the median wall time [s], the CPU time [s] and what the
 run reported. Usage: python3 tools/scale_bench.py [--build build] [--repeats 3] [--waypoints 1000]
 [--obstacles 20000] [--only bounds|check] [--path-case CELL:FROM:TO ...] [--compare-runs]
+[--compare-grow]
 """
 import argparse
 import json
@@ -95,6 +100,8 @@ def main():
     ap.add_argument("--only", choices=["bounds", "check"], help="run one of the two cases")
     ap.add_argument("--compare-runs", action="store_true",
                     help="also bound each path once with safety.runs = false and compare (a second table)")
+    ap.add_argument("--compare-grow", action="store_true",
+                    help="also bound each path once with --grow none and compare the room (a third table)")
     ap.add_argument("--out", help="also write the table as a docs section here (docs/data/perf/scale.md, "
                                   "which tools/make_results.py includes in docs/results.md)")
     ap.add_argument("--path-case", action="append", metavar="CELL:FROM:TO",
@@ -104,6 +111,7 @@ def main():
     LEEWAY = str((ROOT / args.build / "leeway").resolve())
     rows = []
     compared = []  # (case, with runs: (wall, cpu, bounds json), without: (wall, cpu, bounds json))
+    grown = []  # (case, default: (wall, cpu, bounds json), --grow none: (wall, cpu, bounds json))
     with tempfile.TemporaryDirectory() as tmp:
         folder = pathlib.Path(tmp)
         cases = args.path_case or DEFAULT_CASES
@@ -123,8 +131,11 @@ def main():
             width, guide = widths(d)[0], widths(d, "guide_")[0]
             # Scored once, obstacles and self-collision apart (leeway cf --self: 30 x 10,000 samples).
             cf = json.loads(timed([LEEWAY, "cf", str(cell), str(out), "--self", "--json"])[2])
+            room = d.get("room", {}).get("mean_share")
             note = (f"{len(d['waypoints'])} waypoints, {'certified' if s['certified'] else 'NOT certified'}, "
-                    f"{s['leaves']} leaves; mean j1-j3 width {width:.3f} rad, {100 * width / guide:.1f} % of "
+                    f"{s['leaves']} leaves ({s['grow']['leaves'] if s.get('grow') else 0} growing); "
+                    + (f"room {100 * room:.1f} %; " if room is not None else "") +
+                    f"mean j1-j3 width {width:.3f} rad, {100 * width / guide:.1f} % of "
                     f"the guide's; cf --self: {cf['obstacle_collisions']} obstacle and {cf['self_collisions']} "
                     f"self-collisions in {cf['samples']} samples")
             rows.append((f"bounds {name} {a}-{b} --path ({args.waypoints} waypoints)", runs, 30.0, note))
@@ -135,6 +146,13 @@ def main():
                 with_runs = (statistics.median(r[0] for r in runs), statistics.median(r[1] for r in runs), d)
                 compared.append((f"{name} {a}-{b}", with_runs,
                                  (run_off[0], run_off[1], json.loads(out_off.read_text()))))
+            if args.compare_grow:
+                out_none = folder / "bounds_none.json"
+                run_none = timed([LEEWAY, "bounds", str(cell), "--path", str(p), "--grow", "none",
+                                  "--out", str(out_none)])
+                median = (statistics.median(r[0] for r in runs), statistics.median(r[1] for r in runs), d)
+                grown.append((f"{name} {a}-{b}", median,
+                              (run_none[0], run_none[1], json.loads(out_none.read_text()))))
         if args.only != "bounds":
             cell = crowded_cell(folder, ROOT / "mjcf" / "workcells" / "shelf_bay.xml", args.obstacles, 1)
             # Exit 1: check's findings (the random boxes overlap each other and the robot's reach).
@@ -171,6 +189,21 @@ def main():
             lines.append(f"| {case} | {wall:.2f} / {wall_off:.2f} | {cpu:.2f} / {cpu_off:.2f} | "
                          f"{s['leaves']} / {s_off['leaves']} | {s['runs']['segments']} of {len(s['segments'])} | "
                          f"{shares} |")
+    if grown:
+        lines += ["", "Growth by blocks against none (`--grow none`, one run each; the default's times are the "
+                  "medians above). *room* = the mean over the joints of each joint's kept share of its one-joint "
+                  "free range, measured at 50 evenly spaced waypoints [%]; per joint: default / none [%].", "",
+                  "| path | wall [s]: default / none | CPU [s]: default / none | leaves: default / none "
+                  "(growing) | room [%]: default / none | per joint [%] |",
+                  "|---|---:|---:|---:|---:|---|"]
+        for case, (wall, cpu, d), (wall_none, cpu_none, d_none) in grown:
+            s, s_none = d["safety"], d_none["safety"]
+            share, share_none = d["room"]["joint_share"], d_none["room"]["joint_share"]
+            joints = ", ".join(f"{j} {100 * share[j]:.1f} / {100 * share_none[j]:.1f}" for j in d["joints"])
+            lines.append(f"| {case} | {wall:.2f} / {wall_none:.2f} | {cpu:.2f} / {cpu_none:.2f} | "
+                         f"{s['leaves']} / {s_none['leaves']} ({s['grow']['leaves']}) | "
+                         f"{100 * d['room']['mean_share']:.1f} / {100 * d_none['room']['mean_share']:.1f} | "
+                         f"{joints} |")
     print("\n".join(lines))
     if args.out:
         section = ["## Scale (issue 14)", "",

@@ -103,8 +103,6 @@ void print_safety(const SafetyReport& r, const SafetyParams& params) {
       if (r.grow.ran)
         std::cout << "safety: grew " << r.grow.grown << " intervals beyond the guide, every growth proven ("
                   << r.grow.stats.leaves << " of the leaves)\n";
-      else if (params.grow != "none" && n > 1 && r.all_passed)
-        std::cout << "safety: no growth beyond the guide on a dense path (docs/algorithm.md, \"Growing\")\n";
       break;
     case SafetyMode::kSampled:
       std::cout << "safety: sampled, " << passed << " of " << n << " segments passed "

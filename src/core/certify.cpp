@@ -452,6 +452,16 @@ bool Certifier::segment_probe(CertifyContext& ctx, const Eigen::VectorXd& lower_
   return true;
 }
 
+bool Certifier::box_probe(CertifyContext& ctx, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
+                          CertifyStats& stats, long leaf_limit, int grown_joint) const {
+  check_context(ctx);
+  check_box(*scene_, lower, upper);
+  if (grown_joint >= scene_->dof()) throw InputError("certify: no joint " + std::to_string(grown_joint));
+  const std::vector<int>& pairs =
+      grown_joint < 0 ? all_pairs_ : pairs_moved_by_[static_cast<size_t>(grown_joint)];
+  return probe(ctx, lower, upper, (lower + upper) / 2, leaf_limit, stats, nullptr, &pairs);
+}
+
 bool Certifier::region_free(CertifyContext& ctx, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
                             const CertifyBudget& budget, CertifyStats& stats, CertifyFailure* failure) const {
   check_context(ctx);

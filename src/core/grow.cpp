@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <sstream>
 #include <vector>
@@ -197,6 +198,226 @@ WaypointTargets waypoint_targets(RobotState& state, const Eigen::VectorXd& q, co
   return t;
 }
 
+// A dense path grows by blocks of this many segments: one box (the hull of the block's waypoint
+// boxes, which holds each of its segments' regions) is proven free, then grown one joint side at a
+// time by box slabs, and every waypoint of the block takes the same extent.
+constexpr size_t kBlockSegments = 16;
+// The block's hull proof gets the leaf budget over this (as a run box does), its slabs the slab
+// budget over kBlockSlabDivisor: a block's growth then costs a tenth of its segments' certificate or
+// less (docs/results.md, "Scale"), and where a block slab needs more, its waypoints are close to
+// what they can keep.
+constexpr long kHullBudgetDivisor = 4;
+constexpr long kBlockSlabDivisor = 4;
+// A block's probe walks outward from its extent in steps of this many tolerances, doubling.
+constexpr double kMarchSteps = 16;
+
+// One block's growth on a dense path. Waypoints first..last; `fix_first`, `fix_last`: that end
+// waypoint (shared with a neighbouring block that grew first) keeps its bounds.
+class BlockGrowth {
+ public:
+  BlockGrowth(const Certifier& certifier, CertifyContext& ctx, std::vector<WaypointBounds>& bounds,
+              size_t first, size_t last, bool fix_first, bool fix_last, long max_leaves, CertifyStats& stats)
+      : certifier_(certifier),
+        ctx_(ctx),
+        b_(bounds),
+        first_(first),
+        last_(last),
+        grow_first_(fix_first ? first + 1 : first),
+        grow_last_(fix_last ? last - 1 : last),
+        hull_leaves_(std::max(64L, max_leaves / kHullBudgetDivisor)),
+        slab_leaves_(max_leaves / kSlabBudgetDivisor / kBlockSlabDivisor),
+        stats_(stats) {
+    lo_ = b_[first].lower;
+    hi_ = b_[first].upper;
+    for (size_t k = first + 1; k <= last; ++k) {
+      lo_ = lo_.cwiseMin(b_[k].lower);
+      hi_ = hi_.cwiseMax(b_[k].upper);
+    }
+  }
+
+  // Proves the hull free (every later slab relies on it).
+  bool hull_free() {
+    const CertifyBudget budget{hull_leaves_};
+    return certifier_.region_free(ctx_, lo_, hi_, budget, stats_);
+  }
+
+  // The smallest extent of joint i on `side` over the waypoints that grow (infinite when none do).
+  double current(int i, int side) const {
+    double e = INFINITY;
+    for (size_t k = grow_first(); k <= grow_last(); ++k)
+      e = std::min(e, side ? b_[k].upper[i] - b_[k].q[i] : b_[k].q[i] - b_[k].lower[i]);
+    return e;
+  }
+  // Per joint, the largest extent on `side` that takes some growing waypoint to the joint's limit.
+  Eigen::VectorXd to_limits(int side) const {
+    const Scene& scene = certifier_.scene();
+    Eigen::VectorXd extent = Eigen::VectorXd::Zero(scene.dof());
+    for (size_t k = grow_first(); k <= grow_last(); ++k)
+      extent = extent.cwiseMax(side ? scene.upper_limits() - b_[k].q : b_[k].q - scene.lower_limits());
+    return extent;
+  }
+
+  // Widens joint i on `side` toward extent `target` at every growing waypoint of the block; true
+  // when it stopped short.
+  bool grow(int i, int side, double target, double tolerance) {
+    const double extent = current(i, side);
+    if (!(target > extent + tolerance)) return false;
+    // Outward in doubling steps, then bisection between the last free face and the first one that
+    // is not: the target is the joint's limit, whose face may be free beyond an obstacle the slab
+    // crosses.
+    double ok = extent, bad = target;
+    bool limited = false;
+    for (double step = kMarchSteps * tolerance; ok < target; step *= 2) {
+      const double next = std::min(target, ok + step);
+      if (!face_free(i, side, next)) {
+        bad = next;
+        limited = true;
+        break;
+      }
+      ok = next;
+    }
+    double candidate = target;
+    if (limited) {
+      while (bad - ok > tolerance) {
+        const double mid = (ok + bad) / 2;
+        (face_free(i, side, mid) ? ok : bad) = mid;
+      }
+      candidate = ok - 2 * tolerance;
+      if (!(candidate > extent + tolerance)) return true;
+    }
+    const double thin = extent + (candidate - extent) / 8;
+    if (!slab_free(i, side, thin, slab_leaves_ / kThinSlabDivisor)) return true;
+    set(i, side, thin);
+    if (slab_free(i, side, candidate, slab_leaves_)) {
+      set(i, side, candidate);
+      return limited;
+    }
+    double proven = thin, refused = candidate;
+    for (int step = 0; step < kCertifySteps; ++step) {
+      const double mid = (proven + refused) / 2;
+      if (slab_free(i, side, mid, slab_leaves_ / 2)) {
+        set(i, side, mid);
+        proven = mid;
+      } else {
+        refused = mid;
+      }
+    }
+    return true;
+  }
+
+ private:
+  // The waypoints that grow (none in a one-segment block whose ends are fixed).
+  size_t grow_first() const { return grow_first_; }
+  size_t grow_last() const { return grow_last_; }
+
+  // The hull's edge of joint i on `side` with every growing waypoint at least `extent` wide there.
+  double edge(int i, int side, double extent) const {
+    double edge = side ? hi_[i] : lo_[i];
+    for (size_t k = grow_first(); k <= grow_last(); ++k)
+      edge = side ? std::max(edge, widened(k, i, side, extent)) : std::min(edge, widened(k, i, side, extent));
+    return edge;
+  }
+
+  // Waypoint k's bound of joint i on `side` widened to `extent`, within the joint's limits.
+  double widened(size_t k, int i, int side, double extent) const {
+    const WaypointBounds& w = b_[k];
+    const RobotJoint& joint = certifier_.scene().joints()[static_cast<size_t>(i)];
+    return side ? std::max(w.upper[i], std::min(joint.upper, w.q[i] + extent))
+                : std::min(w.lower[i], std::max(joint.lower, w.q[i] - extent));
+  }
+
+  // The slab the growth adds to the hull, joint i from the hull's edge to the new one.
+  std::pair<Eigen::VectorXd, Eigen::VectorXd> slab(int i, int side, double extent) const {
+    Eigen::VectorXd lo = lo_, hi = hi_;
+    const double to = edge(i, side, extent);
+    if (side) {
+      lo[i] = hi_[i];
+      hi[i] = to;
+    } else {
+      hi[i] = lo_[i];
+      lo[i] = to;
+    }
+    return {lo, hi};
+  }
+
+  // The probe: the slab's outer face (joint i at the new edge) and samples of it, only the pairs
+  // joint i moves. A slab that comes too close does so at its outer face first, in most cases.
+  bool face_free(int i, int side, double extent) const {
+    auto [lo, hi] = slab(i, side, extent);
+    (side ? lo[i] : hi[i]) = side ? hi[i] : lo[i];
+    return certifier_.box_probe(ctx_, lo, hi, stats_, std::numeric_limits<long>::max(), i);
+  }
+
+  bool slab_free(int i, int side, double extent, long leaves) const {
+    const auto [lo, hi] = slab(i, side, extent);
+    if (!(hi[i] > lo[i])) return true;  // the hull holds it already
+    const CertifyBudget budget{std::max(64L, leaves)};
+    return certifier_.segment_free(ctx_, lo, hi, lo, hi, budget, stats_, nullptr, nullptr, i);
+  }
+
+  void set(int i, int side, double extent) {
+    const double to = edge(i, side, extent);
+    (side ? hi_[i] : lo_[i]) = to;
+    for (size_t k = grow_first(); k <= grow_last(); ++k)
+      (side ? b_[k].upper[i] : b_[k].lower[i]) = widened(k, i, side, extent);
+  }
+
+  const Certifier& certifier_;
+  CertifyContext& ctx_;
+  std::vector<WaypointBounds>& b_;
+  const size_t first_, last_;
+  const size_t grow_first_, grow_last_;
+  const long hull_leaves_, slab_leaves_;
+  CertifyStats& stats_;
+  Eigen::VectorXd lo_, hi_;  // the hull, proven free once hull_free() said so
+};
+
+// The growth of one block of a dense path. A block's fixed ends were grown by the even blocks
+// beside it: when the block cannot grow (a segment not certified, or its hull not proven), they go
+// back to their bounds from before any growth, a subset of what those blocks proved and what this
+// block's segments were certified with.
+struct DenseBlock {
+  const Certifier& certifier;
+  CertifyContext& ctx;
+  std::vector<WaypointBounds>& bounds;
+  const std::vector<WaypointBounds>& before;
+  const std::vector<SegmentSafety>& segments;
+  const std::vector<bool>& mask;
+  const Eigen::VectorXd& caps;
+  long max_leaves;
+  CertifyStats& stats;
+
+  void grow(size_t first, size_t last, bool fix_first, bool fix_last) {
+    bool certified = true;
+    for (size_t s = first; s < last; ++s) certified = certified && segments[s].passed;
+    if (certified) {
+      BlockGrowth growth(certifier, ctx, bounds, first, last, fix_first, fix_last, max_leaves, stats);
+      if (growth.hull_free()) {
+        widen(growth);
+        return;
+      }
+    }
+    if (fix_first) bounds[first] = before[first];
+    if (fix_last) bounds[last] = before[last];
+  }
+
+  // One pass, tip to base, each side straight toward its joint limits (or caps): the face probe's
+  // walk and bisection find where the block's slab first comes within the margin. (A block's box
+  // meets an obstacle well before the one-joint free range does, and that range, at every block,
+  // cost more than the growth it aimed.)
+  void widen(BlockGrowth& growth) const {
+    const Scene& scene = certifier.scene();
+    const Eigen::VectorXd below = growth.to_limits(0).cwiseMin(caps),
+                          above = growth.to_limits(1).cwiseMin(caps);
+    for (int i = scene.dof() - 1; i >= 0; --i) {
+      if (!mask[static_cast<size_t>(i)]) continue;
+      const double tolerance =
+          scene.joints()[static_cast<size_t>(i)].prismatic ? kSlideTolerance : kHingeTolerance;
+      for (int side = 0; side < 2; ++side) growth.grow(i, side, side ? above[i] : below[i], tolerance);
+    }
+  }
+};
+
 }  // namespace
 
 std::vector<bool> grow_mask(const Scene& scene, const SafetyParams& params) {
@@ -308,6 +529,50 @@ GrowReport grow_bounds(const Scene& scene, std::vector<WaypointBounds>& bounds,
       if (bounds[k].lower[i] < bounds[k].guide_lower[i] || bounds[k].upper[i] > bounds[k].guide_upper[i])
         ++report.grown;
   }
+  report.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return report;
+}
+
+GrowReport grow_dense(const Scene& scene, std::vector<WaypointBounds>& bounds,
+                      const std::vector<SegmentSafety>& segments, const SafetyParams& params,
+                      const CertifyOptions& options, int threads) {
+  const auto t0 = std::chrono::steady_clock::now();
+  GrowReport report;
+  const std::vector<bool> mask = grow_mask(scene, params);
+  const Eigen::VectorXd caps = half_width_caps(scene, params);
+  const int n = scene.dof();
+  const size_t count = bounds.size();
+  for (auto& w : bounds)
+    for (int i = 0; i < n; ++i) {
+      w.lower[i] = std::max(w.lower[i], w.q[i] - caps[i]);
+      w.upper[i] = std::min(w.upper[i], w.q[i] + caps[i]);
+    }
+  if (count < 2 || std::none_of(mask.begin(), mask.end(), [](bool b) { return b; })) return report;
+  report.ran = true;
+  const size_t blocks = (count - 2) / kBlockSegments + 1;
+  std::vector<CertifyStats> stats(blocks);
+  const Certifier certifier(scene, options);
+  // Even blocks first, in parallel; then odd ones, whose two end waypoints the even ones grew.
+  const std::vector<WaypointBounds> before = bounds;
+  for (size_t parity = 0; parity < 2; ++parity) {
+    std::vector<size_t> jobs;
+    for (size_t g = parity; g < blocks; g += 2) jobs.push_back(g);
+    detail::parallel_for(static_cast<int>(jobs.size()), threads, [&] {
+      auto ctx = std::make_shared<CertifyContext>(scene);
+      return [&, ctx](int job) {
+        const size_t g = jobs[static_cast<size_t>(job)];
+        const size_t first = g * kBlockSegments, last = std::min(first + kBlockSegments, count - 1);
+        // An odd block's ends belong to the even blocks beside it (the path's last waypoint does not).
+        DenseBlock block{certifier, *ctx, bounds, before, segments, mask, caps, params.max_leaves, stats[g]};
+        block.grow(first, last, parity == 1, parity == 1 && last + 1 < count);
+      };
+    });
+  }
+  for (size_t g = 0; g < blocks; ++g) report.stats.add(stats[g]);
+  for (size_t k = 0; k < count; ++k)
+    for (int i = 0; i < n; ++i)
+      if (bounds[k].lower[i] < bounds[k].guide_lower[i] || bounds[k].upper[i] > bounds[k].guide_upper[i])
+        ++report.grown;
   report.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return report;
 }

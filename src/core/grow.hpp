@@ -32,4 +32,16 @@ GrowReport grow_bounds(const Scene& scene, std::vector<WaypointBounds>& bounds,
                        const std::vector<SegmentSafety>& segments, const SafetyParams& params,
                        const CertifyOptions& options, int threads);
 
+//! grow_bounds for a dense path: blocks of 16 consecutive segments, each grown as one box. The
+//! hull of a block's waypoint boxes (which holds each of its segments' regions) is proven free
+//! first; then each side of each grown joint, tip to base in one pass, is widened toward the
+//! joint's limit (capped) at every waypoint of the block to the same extent: a probe of the hull's
+//! new face walks outward and bisects, and the box slab the step adds to the hull is proven (only
+//! the pairs the joint moves). Even blocks, then odd ones, run in parallel; an odd block keeps its
+//! end waypoints as the even blocks left them, or gives them back when it cannot grow. The result
+//! does not depend on the thread count.
+GrowReport grow_dense(const Scene& scene, std::vector<WaypointBounds>& bounds,
+                      const std::vector<SegmentSafety>& segments, const SafetyParams& params,
+                      const CertifyOptions& options, int threads);
+
 }  // namespace leeway

@@ -599,14 +599,13 @@ SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, 
       if (e.below[k][i] != original.below[k][i]) bounds[k].lower[i] = bounds[k].q[i] - e.below[k][i];
       if (e.above[k][i] != original.above[k][i]) bounds[k].upper[i] = bounds[k].q[i] + e.above[k][i];
     }
-  // Growth runs on sparse paths: on a dense one it would cost several times the certified mode's
-  // work (docs/algorithm.md, "Growing"). The caps apply to every path.
-  if (params.mode == SafetyMode::kCertified && (!dense || !params.max_half_width.empty()) &&
-      (params.grow != "none" || !params.max_half_width.empty())) {
-    SafetyParams growth = params;
-    if (dense) growth.grow = "none";
+  // Growth, waypoint by waypoint on a sparse path; on a dense one by blocks of segments, each grown
+  // as one box, since waypoint by waypoint it cost several times the certified mode's work
+  // (docs/algorithm.md, "Growing"). The caps apply to every path.
+  if (params.mode == SafetyMode::kCertified && (params.grow != "none" || !params.max_half_width.empty())) {
     report.grow =
-        grow_bounds(scene, bounds, report.segments, growth, certify_options(params, bound), threads);
+        dense ? grow_dense(scene, bounds, report.segments, params, certify_options(params, bound), threads)
+              : grow_bounds(scene, bounds, report.segments, params, certify_options(params, bound), threads);
     report.stats.add(report.grow.stats);
   }
   report.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -137,6 +137,13 @@ class Certifier {
                      CertifyFailure* failure = nullptr, long leaf_limit = std::numeric_limits<long>::max(),
                      int grown_joint = -1) const;
 
+  //! A quick necessary test of a box, not a proof: exact checks (the margin included) of its corners
+  //! (up to 256; beyond 8 moving joints a seeded choice of them) and its centre. `grown_joint` as in
+  //! segment_probe. Each check counts a leaf against `leaf_limit`.
+  bool box_probe(CertifyContext& ctx, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
+                 CertifyStats& stats, long leaf_limit = std::numeric_limits<long>::max(),
+                 int grown_joint = -1) const;
+
   //! One leaf, no subdivision: true when the bound proves the box free.
   bool leaf_free(CertifyContext& ctx, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
                  CertifyStats& stats, CertifyFailure* failure = nullptr) const;

@@ -47,6 +47,35 @@ std::vector<std::string> split_names(const std::string& text) {
   return names;
 }
 
+// The certificate's part of one growth step from `extent` to the probe's `candidate`, for a
+// waypoint or a block: a thin slab first, on a small budget (when it cannot be proven, the thicker
+// ones cannot either, almost always, and a failing slab costs its whole budget), then the whole
+// step, then kCertifySteps bisection steps. slab_free(to, leaves) proves the slab from the current
+// extent to `to`; set(to) keeps it. True when the step stopped short of the candidate, or `limited`
+// (the probe stopped it short of its target).
+template <class SlabFree, class Set>
+bool certify_step(double extent, double candidate, bool limited, long slab_leaves, SlabFree slab_free,
+                  Set set) {
+  const double thin = extent + (candidate - extent) / 8;
+  if (!slab_free(thin, slab_leaves / kThinSlabDivisor)) return true;
+  set(thin);
+  if (slab_free(candidate, slab_leaves)) {
+    set(candidate);
+    return limited;
+  }
+  double proven = thin, refused = candidate;
+  for (int step = 0; step < kCertifySteps; ++step) {
+    const double mid = (proven + refused) / 2;
+    if (slab_free(mid, slab_leaves / 2)) {
+      set(mid);
+      proven = mid;
+    } else {
+      refused = mid;
+    }
+  }
+  return true;
+}
+
 // One waypoint's growth: the certifier of this thread, the bounds (its neighbours are read only).
 class WaypointGrowth {
  public:
@@ -81,26 +110,10 @@ class WaypointGrowth {
       limited = true;
       if (!(candidate > extent + tolerance)) return true;
     }
-    // A thin slab first, on a small budget: when it cannot be proven, the thicker ones cannot
-    // either, almost always, and a failing slab costs its whole budget.
-    const double thin = extent + (candidate - extent) / 8;
-    if (!slab_free(i, side, thin, slab_leaves_ / kThinSlabDivisor)) return true;
-    set(i, side, thin);
-    if (slab_free(i, side, candidate, slab_leaves_)) {
-      set(i, side, candidate);
-      return limited;
-    }
-    double ok = thin, bad = candidate;
-    for (int step = 0; step < kCertifySteps; ++step) {
-      const double mid = (ok + bad) / 2;
-      if (slab_free(i, side, mid, slab_leaves_ / 2)) {
-        set(i, side, mid);
-        ok = mid;
-      } else {
-        bad = mid;
-      }
-    }
-    return true;
+    return certify_step(
+        extent, candidate, limited, slab_leaves_,
+        [&](double to, long leaves) { return slab_free(i, side, to, leaves); },
+        [&](double to) { set(i, side, to); });
   }
 
   double current(int i, int side) const {
@@ -285,24 +298,10 @@ class BlockGrowth {
       candidate = ok - 2 * tolerance;
       if (!(candidate > extent + tolerance)) return true;
     }
-    const double thin = extent + (candidate - extent) / 8;
-    if (!slab_free(i, side, thin, slab_leaves_ / kThinSlabDivisor)) return true;
-    set(i, side, thin);
-    if (slab_free(i, side, candidate, slab_leaves_)) {
-      set(i, side, candidate);
-      return limited;
-    }
-    double proven = thin, refused = candidate;
-    for (int step = 0; step < kCertifySteps; ++step) {
-      const double mid = (proven + refused) / 2;
-      if (slab_free(i, side, mid, slab_leaves_ / 2)) {
-        set(i, side, mid);
-        proven = mid;
-      } else {
-        refused = mid;
-      }
-    }
-    return true;
+    return certify_step(
+        extent, candidate, limited, slab_leaves_,
+        [&](double to, long leaves) { return slab_free(i, side, to, leaves); },
+        [&](double to) { set(i, side, to); });
   }
 
  private:

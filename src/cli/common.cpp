@@ -66,8 +66,9 @@ void add_joint_bounds_options(CLI::App* sub, JointBoundsOptions& options) {
                   "default: bounds.wrist_half_width (hinge), bounds.linear_axis_tolerance (slide)")
       ->check(non_empty_check("NAME=VALUE pairs, e.g. j5=0.3,j6=0.1"));
   sub->add_option("--grow", options.grow,
-                  "Certified mode: the joints grown beyond the guide toward their free range: all, none\n"
-                  "or names, e.g. j4,j5,j6; default: the parameters' safety.grow (all)")
+                  "Certified mode: the joints grown beyond the guide toward their free range (on a dense\n"
+                  "path by blocks, toward their limits): all, none or names, e.g. j4,j5,j6; default: the\n"
+                  "parameters' safety.grow (all)")
       ->check(non_empty_check("all, none or joint names, e.g. j4,j5,j6"));
   sub->add_option("--max-half-width", options.max_half_width,
                   "Certified mode: the largest half-width a joint may keep [rad or m], e.g. j5=0.5,j6=0.3;\n"

@@ -215,10 +215,9 @@ WaypointTargets waypoint_targets(RobotState& state, const Eigen::VectorXd& q, co
 // boxes, which holds each of its segments' regions) is proven free, then grown one joint side at a
 // time by box slabs, and every waypoint of the block takes the same extent.
 constexpr size_t kBlockSegments = 16;
-// The block's hull proof gets the leaf budget over this (as a run box does), its slabs the slab
-// budget over kBlockSlabDivisor: a block's growth then costs a tenth of its segments' certificate or
-// less (docs/results.md, "Scale"), and where a block slab needs more, its waypoints are close to
-// what they can keep.
+// The block's hull proof gets the leaf budget over this (as a run box does), its slabs a
+// waypoint's slab budget over kBlockSlabDivisor, so that a dense path's growth stays a small part
+// of its certificate's cost (docs/results.md, "Scale").
 constexpr long kHullBudgetDivisor = 4;
 constexpr long kBlockSlabDivisor = 4;
 // A block's probe walks outward from its extent in steps of this many tolerances, doubling.
@@ -402,8 +401,8 @@ struct DenseBlock {
 
   // One pass, tip to base, each side straight toward its joint limits (or caps): the face probe's
   // walk and bisection find where the block's slab first comes within the margin. (A block's box
-  // meets an obstacle well before the one-joint free range does, and that range, at every block,
-  // cost more than the growth it aimed.)
+  // meets an obstacle before the one-joint free range ends, and that range, computed at every
+  // block, cost about as much as the growth it aimed: docs/algorithm.md, "Growing".)
   void widen(BlockGrowth& growth) const {
     const Scene& scene = certifier.scene();
     const Eigen::VectorXd below = growth.to_limits(0).cwiseMin(caps),

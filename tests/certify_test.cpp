@@ -610,16 +610,9 @@ const std::string kRailCell =
 const std::string kRailPlaneCell =
     rail_cell(R"(<geom name="stop" type="plane" size="1 1 0.1" pos="1 0 0.5" zaxis="-1 0 0"/>)");
 
-// A slab's probe (segment_probe with grown_joint) checks only the pairs the grown joint moves. A
-// two-link arm (j1 at the origin, 1 m link 1 along x; j2 at its tip, 0.5 m link 2) and a post over
-// x, y in [0.3, 0.6]. At j1 = 0.6 rad link 1's upper edge passes (0.5 cos 0.6 - 0.05 sin 0.6,
-// 0.5 sin 0.6 + 0.05 cos 0.6) = (0.385, 0.323), inside the post; link 2 starts at its tip
-// (0.825, 0.565): pointing along x (j2 = -0.6 +- 0.1) it stays at x >= 0.82, clear of the post, and
-// folded back (j2 = 2.45 .. 2.5, pointing at 3.05 .. 3.1 rad) it runs to (0.33, 0.61 .. 0.59)
-// through the post.
-TEST_F(CertifyTest, SlabProbesCheckOnlyThePairsTheGrownJointMoves) {
-  test::TempDir dir;
-  const Scene scene = Scene::load(dir.write("cell.xml", R"(<mujoco model="two-link-post">
+// A two-link arm (j1 at the origin, 1 m link 1 along x; j2 at its tip, 0.5 m link 2) and a post over
+// x, y in [0.3, 0.6].
+const char* kTwoLinkPost = R"(<mujoco model="two-link-post">
   <compiler angle="radian" autolimits="true"/>
   <worldbody>
     <body name="link1" pos="0 0 0.5">
@@ -634,7 +627,17 @@ TEST_F(CertifyTest, SlabProbesCheckOnlyThePairsTheGrownJointMoves) {
     <geom name="post" type="box" size="0.15 0.15 1" pos="0.45 0.45 0.5"/>
   </worldbody>
 </mujoco>
-)"));
+)";
+
+// A slab's probe (segment_probe with grown_joint) checks only the pairs the grown joint moves, on
+// kTwoLinkPost. At j1 = 0.6 rad link 1's upper edge passes (0.5 cos 0.6 - 0.05 sin 0.6,
+// 0.5 sin 0.6 + 0.05 cos 0.6) = (0.385, 0.323), inside the post; link 2 starts at its tip
+// (0.825, 0.565): pointing along x (j2 = -0.6 +- 0.1) it stays at x >= 0.82, clear of the post, and
+// folded back (j2 = 2.45 .. 2.5, pointing at 3.05 .. 3.1 rad) it runs to (0.33, 0.61 .. 0.59)
+// through the post.
+TEST_F(CertifyTest, SlabProbesCheckOnlyThePairsTheGrownJointMoves) {
+  test::TempDir dir;
+  const Scene scene = Scene::load(dir.write("cell.xml", kTwoLinkPost));
   RobotState state(scene);
   Certifier certifier(scene, CertifyOptions{});
   CertifyContext ctx(scene);
@@ -657,27 +660,12 @@ TEST_F(CertifyTest, SlabProbesCheckOnlyThePairsTheGrownJointMoves) {
                InputError);
 }
 
-// The box probe of dense-path growth, on the same arm and post: its corners are checked (a box
+// The box probe of dense-path growth, on kTwoLinkPost: its corners are checked (a box
 // whose centre is free but whose corner j1 = 0.6 is in the post fails), and with grown_joint only
 // the pairs that joint moves (link 2's).
 TEST_F(CertifyTest, BoxProbesCheckTheCornersAndOnlyThePairsTheGrownJointMoves) {
   test::TempDir dir;
-  const Scene scene = Scene::load(dir.write("cell.xml", R"(<mujoco model="two-link-post">
-  <compiler angle="radian" autolimits="true"/>
-  <worldbody>
-    <body name="link1" pos="0 0 0.5">
-      <joint name="j1" type="hinge" axis="0 0 1" range="-2.5 2.5"/>
-      <geom name="link1_box" type="box" size="0.5 0.05 0.05" pos="0.5 0 0"/>
-      <body name="link2" pos="1 0 0">
-        <joint name="j2" type="hinge" axis="0 0 1" range="-2.5 2.5"/>
-        <geom name="link2_box" type="box" size="0.25 0.05 0.05" pos="0.25 0 0"/>
-        <site name="tool0" pos="0.5 0 0"/>
-      </body>
-    </body>
-    <geom name="post" type="box" size="0.15 0.15 1" pos="0.45 0.45 0.5"/>
-  </worldbody>
-</mujoco>
-)"));
+  const Scene scene = Scene::load(dir.write("cell.xml", kTwoLinkPost));
   RobotState state(scene);
   Certifier certifier(scene, CertifyOptions{});
   CertifyContext ctx(scene);

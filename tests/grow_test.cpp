@@ -92,6 +92,19 @@ double sampled_clearance(const Scene& scene, const std::vector<WaypointBounds>& 
   return best;
 }
 
+// A dense two-link path: 81 waypoints, j1 from -0.3 to -0.1 rad and j2 from 0.5 to 0.7 rad (2.5 mrad
+// apart), the guide j1 +-0.1 and j2 0.3 below and 0.8 above the nominal: through the wall (link 2's
+// far corner is at y = sin j1 + 0.5 sin(j1 + j2) + 0.05 cos(j1 + j2), 0.22 m at the last nominal,
+// 0.50 m at its guide's upper corner; the wall is at 0.45).
+std::vector<WaypointBounds> dense_path_through_the_wall() {
+  std::vector<WaypointBounds> b;
+  for (int k = 0; k <= 80; ++k) {
+    const Eigen::VectorXd q = v2(-0.3 + 0.0025 * k, 0.5 + 0.0025 * k);
+    b.push_back(box(q, q - v2(0.1, 0.3), q + v2(0.1, 0.8)));
+  }
+  return b;
+}
+
 class GrowTest : public ::testing::Test {
  protected:
   test::TempDir dir_;
@@ -212,19 +225,12 @@ TEST_F(GrowTest, TwoLinkGrowingBothJointsStaysFree) {
 }
 
 TEST_F(GrowTest, RunBoxesOfADenseTwoLinkPathNearTheWallAreFree) {
-  // 81 waypoints, j1 from -0.3 to -0.1 rad and j2 from 0.5 to 0.7 rad (2.5 mrad apart), the guide
-  // j1 +-0.1 and j2 0.3 below and 0.8 above the nominal: through the wall (link 2's far corner is at
-  // y = sin j1 + 0.5 sin(j1 + j2) + 0.05 cos(j1 + j2), 0.22 m at the last nominal, 0.50 m at its
-  // guide's upper corner; the wall is at 0.45), so phase-0 segments shrink and the others start
+  // dense_path_through_the_wall: phase-0 segments shrink and the others start
   // warm and are proven by their chain's run boxes. The result must be free with the margin between the
   // waypoints too, the same for one thread and two, and about as wide as proving every segment
   // on its own.
   const Scene scene = Scene::load(dir_.write("two_link.xml", kTwoLink));
-  std::vector<WaypointBounds> b;
-  for (int k = 0; k <= 80; ++k) {
-    const Eigen::VectorXd q = v2(-0.3 + 0.0025 * k, 0.5 + 0.0025 * k);
-    b.push_back(box(q, q - v2(0.1, 0.3), q + v2(0.1, 0.8)));
-  }
+  std::vector<WaypointBounds> b = dense_path_through_the_wall();
   std::vector<WaypointBounds> two_threads = b, without = b;
   SafetyParams params;
   const SafetyReport r = make_safe(scene, b, params, 1);
@@ -277,17 +283,13 @@ TEST_F(GrowTest, DenseOneLinkPathGrowsByBlocksToTheWallLessTheMargin) {
   EXPECT_GE(sampled_clearance(scene, b, 2000), 0.001 - 1e-9);
 }
 
-// The dense two-link path through the wall of the run-box test below, grown: both joints widen
+// dense_path_through_the_wall, grown: both joints widen
 // beyond the certified bounds somewhere, every certified interval is kept (growth never narrows),
 // the result is free with the margin between the waypoints too (1 mm over the corners and 2,000
 // samples per segment), and it is the same for one thread and two.
 TEST_F(GrowTest, DenseTwoLinkPathNearTheWallGrowsAndStaysFree) {
   const Scene scene = Scene::load(dir_.write("two_link.xml", kTwoLink));
-  std::vector<WaypointBounds> b;
-  for (int k = 0; k <= 80; ++k) {
-    const Eigen::VectorXd q = v2(-0.3 + 0.0025 * k, 0.5 + 0.0025 * k);
-    b.push_back(box(q, q - v2(0.1, 0.3), q + v2(0.1, 0.8)));
-  }
+  std::vector<WaypointBounds> b = dense_path_through_the_wall();
   std::vector<WaypointBounds> two_threads = b, certified = b;
   SafetyParams params;
   const SafetyReport r = make_safe(scene, b, params, 1);

@@ -139,20 +139,16 @@ def main():
                     f"the guide's; cf --self: {cf['obstacle_collisions']} obstacle and {cf['self_collisions']} "
                     f"self-collisions in {cf['samples']} samples")
             rows.append((f"bounds {name} {a}-{b} --path ({args.waypoints} waypoints)", runs, 30.0, note))
-            if args.compare_runs:
-                out_off = folder / "bounds_off.json"
-                run_off = timed([LEEWAY, "bounds", str(cell), "--path", str(p), "--params", str(off),
-                                 "--out", str(out_off)])
-                with_runs = (statistics.median(r[0] for r in runs), statistics.median(r[1] for r in runs), d)
-                compared.append((f"{name} {a}-{b}", with_runs,
-                                 (run_off[0], run_off[1], json.loads(out_off.read_text()))))
-            if args.compare_grow:
-                out_none = folder / "bounds_none.json"
-                run_none = timed([LEEWAY, "bounds", str(cell), "--path", str(p), "--grow", "none",
-                                  "--out", str(out_none)])
-                median = (statistics.median(r[0] for r in runs), statistics.median(r[1] for r in runs), d)
-                grown.append((f"{name} {a}-{b}", median,
-                              (run_none[0], run_none[1], json.loads(out_none.read_text()))))
+            # The same path once more with run boxes off, or growth off: (case, the default's medians
+            # and bounds, the other run's wall, CPU and bounds).
+            median = (statistics.median(r[0] for r in runs), statistics.median(r[1] for r in runs), d)
+            for wanted, extra, table in ((args.compare_runs, ["--params", str(off)], compared),
+                                         (args.compare_grow, ["--grow", "none"], grown)):
+                if wanted:
+                    out_other = folder / "bounds_other.json"
+                    wall, cpu, _ = timed([LEEWAY, "bounds", str(cell), "--path", str(p), *extra,
+                                          "--out", str(out_other)])
+                    table.append((f"{name} {a}-{b}", median, (wall, cpu, json.loads(out_other.read_text()))))
         if args.only != "bounds":
             cell = crowded_cell(folder, ROOT / "mjcf" / "workcells" / "shelf_bay.xml", args.obstacles, 1)
             # Exit 1: check's findings (the random boxes overlap each other and the robot's reach).

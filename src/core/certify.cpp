@@ -410,6 +410,11 @@ bool Certifier::probe(CertifyContext& ctx, const Eigen::VectorXd& lower, const E
   return true;
 }
 
+const std::vector<int>& Certifier::pairs_for(int grown_joint) const {
+  if (grown_joint >= scene_->dof()) throw InputError("certify: no joint " + std::to_string(grown_joint));
+  return grown_joint < 0 ? all_pairs_ : pairs_moved_by_[static_cast<size_t>(grown_joint)];
+}
+
 bool Certifier::segment_probe(CertifyContext& ctx, const Eigen::VectorXd& lower_a,
                               const Eigen::VectorXd& upper_a, const Eigen::VectorXd& lower_b,
                               const Eigen::VectorXd& upper_b, const Eigen::VectorXd& qa,
@@ -420,9 +425,7 @@ bool Certifier::segment_probe(CertifyContext& ctx, const Eigen::VectorXd& lower_
   check_box(*scene_, qb, qb);
   check_box(*scene_, lower_a, upper_a);
   check_box(*scene_, lower_b, upper_b);
-  if (grown_joint >= scene_->dof()) throw InputError("certify: no joint " + std::to_string(grown_joint));
-  const std::vector<int>& pairs =
-      grown_joint < 0 ? all_pairs_ : pairs_moved_by_[static_cast<size_t>(grown_joint)];
+  const std::vector<int>& pairs = pairs_for(grown_joint);
   CertifyFailure local;
   for (double t : {0.0, 1.0, 0.5, 0.25, 0.75}) {
     if (probe(ctx, (1 - t) * lower_a + t * lower_b, (1 - t) * upper_a + t * upper_b, (1 - t) * qa + t * qb,
@@ -456,9 +459,7 @@ bool Certifier::box_probe(CertifyContext& ctx, const Eigen::VectorXd& lower, con
                           CertifyStats& stats, long leaf_limit, int grown_joint) const {
   check_context(ctx);
   check_box(*scene_, lower, upper);
-  if (grown_joint >= scene_->dof()) throw InputError("certify: no joint " + std::to_string(grown_joint));
-  const std::vector<int>& pairs =
-      grown_joint < 0 ? all_pairs_ : pairs_moved_by_[static_cast<size_t>(grown_joint)];
+  const std::vector<int>& pairs = pairs_for(grown_joint);
   return probe(ctx, lower, upper, (lower + upper) / 2, leaf_limit, stats, nullptr, &pairs);
 }
 
@@ -479,9 +480,7 @@ bool Certifier::segment_free(CertifyContext& ctx, const Eigen::VectorXd& lower_a
   check_context(ctx);
   check_box(*scene_, lower_a, upper_a);
   check_box(*scene_, lower_b, upper_b);
-  if (grown_joint >= scene_->dof()) throw InputError("certify: no joint " + std::to_string(grown_joint));
-  const std::vector<int>& pairs =
-      grown_joint < 0 ? all_pairs_ : pairs_moved_by_[static_cast<size_t>(grown_joint)];
+  const std::vector<int>& pairs = pairs_for(grown_joint);
   constexpr double kMinDt = 1.0 / (1 << 20);
   const long start = stats.leaves;
   std::vector<std::pair<double, double>> stack = {{0.0, 1.0}};

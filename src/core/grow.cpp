@@ -47,6 +47,18 @@ std::vector<std::string> split_names(const std::string& text) {
   return names;
 }
 
+// The probe's limit between an extent it accepts (`ok`) and one it refuses (`bad`), found by
+// bisection to `tolerance`, less twice the tolerance: the margin's last millimetre costs the
+// certificate most of its leaves.
+template <class Probe>
+double probe_limit(double ok, double bad, double tolerance, Probe probe) {
+  while (bad - ok > tolerance) {
+    const double mid = (ok + bad) / 2;
+    (probe(mid) ? ok : bad) = mid;
+  }
+  return ok - 2 * tolerance;
+}
+
 // The certificate's part of one growth step from `extent` to the probe's `candidate`, for a
 // waypoint or a block: a thin slab first, on a small budget (when it cannot be proven, the thicker
 // ones cannot either, almost always, and a failing slab costs its whole budget), then the whole
@@ -101,12 +113,7 @@ class WaypointGrowth {
     double candidate = target;
     bool limited = false;
     if (!probe(i, side, target)) {
-      double ok = extent, bad = target;
-      while (bad - ok > tolerance) {
-        const double mid = (ok + bad) / 2;
-        (probe(i, side, mid) ? ok : bad) = mid;
-      }
-      candidate = ok - 2 * tolerance;
+      candidate = probe_limit(extent, target, tolerance, [&](double to) { return probe(i, side, to); });
       limited = true;
       if (!(candidate > extent + tolerance)) return true;
     }
@@ -232,8 +239,6 @@ class BlockGrowth {
       : certifier_(certifier),
         ctx_(ctx),
         b_(bounds),
-        first_(first),
-        last_(last),
         grow_first_(fix_first ? first + 1 : first),
         grow_last_(fix_last ? last - 1 : last),
         hull_leaves_(std::max(64L, max_leaves / kHullBudgetDivisor)),
@@ -256,7 +261,7 @@ class BlockGrowth {
   // The smallest extent of joint i on `side` over the waypoints that grow (infinite when none do).
   double current(int i, int side) const {
     double e = INFINITY;
-    for (size_t k = grow_first(); k <= grow_last(); ++k)
+    for (size_t k = grow_first_; k <= grow_last_; ++k)
       e = std::min(e, side ? b_[k].upper[i] - b_[k].q[i] : b_[k].q[i] - b_[k].lower[i]);
     return e;
   }
@@ -264,7 +269,7 @@ class BlockGrowth {
   Eigen::VectorXd to_limits(int side) const {
     const Scene& scene = certifier_.scene();
     Eigen::VectorXd extent = Eigen::VectorXd::Zero(scene.dof());
-    for (size_t k = grow_first(); k <= grow_last(); ++k)
+    for (size_t k = grow_first_; k <= grow_last_; ++k)
       extent = extent.cwiseMax(side ? scene.upper_limits() - b_[k].q : b_[k].q - scene.lower_limits());
     return extent;
   }
@@ -290,11 +295,7 @@ class BlockGrowth {
     }
     double candidate = target;
     if (limited) {
-      while (bad - ok > tolerance) {
-        const double mid = (ok + bad) / 2;
-        (face_free(i, side, mid) ? ok : bad) = mid;
-      }
-      candidate = ok - 2 * tolerance;
+      candidate = probe_limit(ok, bad, tolerance, [&](double to) { return face_free(i, side, to); });
       if (!(candidate > extent + tolerance)) return true;
     }
     return certify_step(
@@ -304,14 +305,10 @@ class BlockGrowth {
   }
 
  private:
-  // The waypoints that grow (none in a one-segment block whose ends are fixed).
-  size_t grow_first() const { return grow_first_; }
-  size_t grow_last() const { return grow_last_; }
-
   // The hull's edge of joint i on `side` with every growing waypoint at least `extent` wide there.
   double edge(int i, int side, double extent) const {
     double edge = side ? hi_[i] : lo_[i];
-    for (size_t k = grow_first(); k <= grow_last(); ++k)
+    for (size_t k = grow_first_; k <= grow_last_; ++k)
       edge = side ? std::max(edge, widened(k, i, side, extent)) : std::min(edge, widened(k, i, side, extent));
     return edge;
   }
@@ -338,8 +335,8 @@ class BlockGrowth {
     return {lo, hi};
   }
 
-  // The probe: the slab's outer face (joint i at the new edge) and samples of it, only the pairs
-  // joint i moves. A slab that comes too close does so at its outer face first, in most cases.
+  // The probe: the slab's outer face (joint i at the new edge), its corners and centre, only the
+  // pairs joint i moves. A slab that comes too close does so at its outer face first, in most cases.
   bool face_free(int i, int side, double extent) const {
     auto [lo, hi] = slab(i, side, extent);
     (side ? lo[i] : hi[i]) = side ? hi[i] : lo[i];
@@ -356,14 +353,14 @@ class BlockGrowth {
   void set(int i, int side, double extent) {
     const double to = edge(i, side, extent);
     (side ? hi_[i] : lo_[i]) = to;
-    for (size_t k = grow_first(); k <= grow_last(); ++k)
+    for (size_t k = grow_first_; k <= grow_last_; ++k)
       (side ? b_[k].upper[i] : b_[k].lower[i]) = widened(k, i, side, extent);
   }
 
   const Certifier& certifier_;
   CertifyContext& ctx_;
   std::vector<WaypointBounds>& b_;
-  const size_t first_, last_;
+  // The waypoints that grow (none in a one-segment block whose ends are fixed).
   const size_t grow_first_, grow_last_;
   const long hull_leaves_, slab_leaves_;
   CertifyStats& stats_;
@@ -448,22 +445,43 @@ Eigen::VectorXd half_width_caps(const Scene& scene, const SafetyParams& params) 
   return caps;
 }
 
+namespace {
+
+// Every interval capped (a cap narrows what the guide gave too: a subset of a certified region is
+// certified); the caps, for growth not to pass them either.
+Eigen::VectorXd cap_intervals(const Scene& scene, const SafetyParams& params,
+                              std::vector<WaypointBounds>& bounds) {
+  const Eigen::VectorXd caps = half_width_caps(scene, params);
+  for (auto& w : bounds) {
+    w.lower = w.lower.cwiseMax(w.q - caps);
+    w.upper = w.upper.cwiseMin(w.q + caps);
+  }
+  return caps;
+}
+
+// The intervals (waypoint x joint) wider than the guide's on some side.
+int grown_intervals(const std::vector<WaypointBounds>& bounds) {
+  int grown = 0;
+  for (const WaypointBounds& w : bounds)
+    grown += static_cast<int>(
+        ((w.lower.array() < w.guide_lower.array()) || (w.upper.array() > w.guide_upper.array())).count());
+  return grown;
+}
+
+bool any(const std::vector<bool>& mask) { return std::find(mask.begin(), mask.end(), true) != mask.end(); }
+
+}  // namespace
+
 GrowReport grow_bounds(const Scene& scene, std::vector<WaypointBounds>& bounds,
                        const std::vector<SegmentSafety>& segments, const SafetyParams& params,
                        const CertifyOptions& options, int threads) {
   const auto t0 = std::chrono::steady_clock::now();
   GrowReport report;
   const std::vector<bool> mask = grow_mask(scene, params);
-  const Eigen::VectorXd caps = half_width_caps(scene, params);
+  const Eigen::VectorXd caps = cap_intervals(scene, params, bounds);
   const int n = scene.dof();
   const size_t count = bounds.size();
-  // A cap narrows what the guide gave too (a subset of a certified region is certified).
-  for (auto& w : bounds)
-    for (int i = 0; i < n; ++i) {
-      w.lower[i] = std::max(w.lower[i], w.q[i] - caps[i]);
-      w.upper[i] = std::min(w.upper[i], w.q[i] + caps[i]);
-    }
-  if (std::none_of(mask.begin(), mask.end(), [](bool b) { return b; })) return report;
+  if (!any(mask)) return report;
   report.ran = true;
   // Only a waypoint whose every segment is certified grows (the slabs rely on it).
   std::vector<bool> grows(count, false);
@@ -521,12 +539,8 @@ GrowReport grow_bounds(const Scene& scene, std::vector<WaypointBounds>& bounds,
         };
       });
     }
-  for (size_t k = 0; k < count; ++k) {
-    report.stats.add(stats[k]);
-    for (int i = 0; i < n; ++i)
-      if (bounds[k].lower[i] < bounds[k].guide_lower[i] || bounds[k].upper[i] > bounds[k].guide_upper[i])
-        ++report.grown;
-  }
+  for (const CertifyStats& st : stats) report.stats.add(st);
+  report.grown = grown_intervals(bounds);
   report.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return report;
 }
@@ -537,15 +551,9 @@ GrowReport grow_dense(const Scene& scene, std::vector<WaypointBounds>& bounds,
   const auto t0 = std::chrono::steady_clock::now();
   GrowReport report;
   const std::vector<bool> mask = grow_mask(scene, params);
-  const Eigen::VectorXd caps = half_width_caps(scene, params);
-  const int n = scene.dof();
+  const Eigen::VectorXd caps = cap_intervals(scene, params, bounds);
   const size_t count = bounds.size();
-  for (auto& w : bounds)
-    for (int i = 0; i < n; ++i) {
-      w.lower[i] = std::max(w.lower[i], w.q[i] - caps[i]);
-      w.upper[i] = std::min(w.upper[i], w.q[i] + caps[i]);
-    }
-  if (count < 2 || std::none_of(mask.begin(), mask.end(), [](bool b) { return b; })) return report;
+  if (count < 2 || !any(mask)) return report;
   report.ran = true;
   const size_t blocks = (count - 2) / kBlockSegments + 1;
   std::vector<CertifyStats> stats(blocks);
@@ -566,11 +574,8 @@ GrowReport grow_dense(const Scene& scene, std::vector<WaypointBounds>& bounds,
       };
     });
   }
-  for (size_t g = 0; g < blocks; ++g) report.stats.add(stats[g]);
-  for (size_t k = 0; k < count; ++k)
-    for (int i = 0; i < n; ++i)
-      if (bounds[k].lower[i] < bounds[k].guide_lower[i] || bounds[k].upper[i] > bounds[k].guide_upper[i])
-        ++report.grown;
+  for (const CertifyStats& st : stats) report.stats.add(st);
+  report.grown = grown_intervals(bounds);
   report.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return report;
 }

@@ -193,6 +193,9 @@ class Certifier {
              const Eigen::VectorXd& nominal, long leaf_limit, CertifyStats& stats, CertifyFailure* failure,
              const std::vector<int>* checked = nullptr) const;
   void check_context(const CertifyContext& ctx) const;
+  // The pairs a slab that grows `grown_joint` must prove (all of them when it is negative).
+  // @throws InputError when the robot has no such joint.
+  const std::vector<int>& pairs_for(int grown_joint) const;
 
   const Scene* scene_;
   CertifyOptions options_;

@@ -3,10 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <random>
 #include <string>
 
 #include "leeway/core/kinematics.hpp"
 #include "leeway/core/room.hpp"
+#include "room_ceiling.hpp"
 #include "test_util.hpp"
 
 namespace leeway {
@@ -85,6 +88,90 @@ TEST_F(RoomTest, ALongPathIsMeasuredAtEvenlySpacedWaypointsAndTheResultIsDetermi
   }
   options.max_waypoints = 0;
   EXPECT_EQ(measure_room(*scene_, path, options).waypoints.size(), 200u);
+}
+
+// The ceiling study's sampled growth (bench/room_ceiling.hpp), on the one-link arm: one waypoint at
+// 0.2 rad grown from zero width. Its one joint's box is checked at both corners, so it ends below
+// the touch angle and at most one last step (1/512 of the free side, 1 rad) short of it; the free
+// side is the joint limit, reached exactly (32 steps of 1/32).
+TEST_F(RoomTest, TheCeilingOfOneWaypointReachesTheWallAndTheLimit) {
+  RoomCeiling ceiling(*scene_, {box(0.2, 0.2, 0.2)}, CeilingOptions{});
+  const CeilingExtents grown = ceiling.grow(ceiling.zero(), false);
+  const double upper = ceiling.upper(grown, 0)[0], lower = ceiling.lower(grown, 0)[0];
+  EXPECT_LE(upper, kTouch);
+  EXPECT_GE(upper, kTouch - (kTouch - 0.2) / 512 - 1e-4);
+  EXPECT_NEAR(lower, -3.0, 1e-9);
+  EXPECT_NEAR(ceiling.mean_share(grown), (upper - lower) / (ceiling.free_ranges(0)[0].upper + 3.0), 1e-12);
+}
+
+// A planar two-link arm (link 1 of 1 m about z at the base, j1 within [-0.65, 0.65] rad; link 2 of
+// 0.5 m about z at its tip) turning j1 from -0.6 to 0.6 rad with j2 at 0, and a post at 0.9 rad,
+// 1.2 m from the base. Only near the end can link 2 reach the post (from j1 = 0.6 the post is
+// 0.38 m from link 1's tip; from j1 <= 0 it is more than 0.97 m away, beyond link 2's 0.5 m):
+// alone, the first waypoint's j2 is limited only where its own j1 side turns link 2 toward the
+// post; with lower and upper linear between the waypoints, the segment's end narrows it further.
+const char* kTwoLinkPostCell = R"(<mujoco model="two-link-post">
+  <compiler angle="radian" autolimits="true"/>
+  <worldbody>
+    <body name="base">
+      <geom name="base_box" type="box" size="0.1 0.1 0.2" pos="0 0 0.2"/>
+      <body name="link1" pos="0 0 0.5">
+        <joint name="j1" type="hinge" axis="0 0 1" range="-0.65 0.65"/>
+        <geom name="l1_box" type="box" size="0.5 0.05 0.05" pos="0.5 0 0"/>
+        <body name="link2" pos="1 0 0">
+          <joint name="j2" type="hinge" axis="0 0 1" range="-2.5 2.5"/>
+          <geom name="l2_box" type="box" size="0.25 0.05 0.05" pos="0.25 0 0"/>
+          <site name="tool0" pos="0.5 0 0"/>
+        </body>
+      </body>
+    </body>
+    <geom name="post" type="box" size="0.05 0.05 0.5" pos="0.7460 0.9400 0.5"/>
+  </worldbody>
+</mujoco>
+)";
+
+TEST(RoomCeilingTest, TheSegmentContractKeepsLessThanTheWaypointsAloneAndIsFree) {
+  test::TempDir dir;
+  const Scene scene = Scene::load(dir.write("cell.xml", kTwoLinkPostCell));
+  auto at = [](double j1) {
+    const Eigen::Vector2d q(j1, 0.0);
+    return WaypointBounds(q, q, q);
+  };
+  RoomCeiling ceiling(scene, {at(-0.6), at(0.6)}, CeilingOptions{});
+  const CeilingExtents alone = ceiling.grow(ceiling.zero(), false);
+  const CeilingExtents segment = ceiling.grow(ceiling.zero(), true);
+  EXPECT_LT(ceiling.upper(segment, 0)[1], ceiling.upper(alone, 0)[1] - 0.3);
+  // The segment's region, checked independently: corners at 101 parameters and 20,000 samples.
+  // Sampling can miss thin collisions (the estimate errs high): at most 0.1 % of them collide.
+  RobotState state(scene);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const Eigen::Vector2d la = ceiling.lower(segment, 0), ua = ceiling.upper(segment, 0);
+  const Eigen::Vector2d lb = ceiling.lower(segment, 1), ub = ceiling.upper(segment, 1);
+  int hits = 0;
+  for (int s = 0; s <= 100; ++s) {
+    const double t = s / 100.0;
+    const Eigen::Vector2d lo = la + t * (lb - la), hi = ua + t * (ub - ua);
+    for (int c = 0; c < 4; ++c)
+      hits += state.in_collision(Eigen::Vector2d(c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1]));
+  }
+  for (int j = 0; j < 20000; ++j) {
+    const double t = unit(rng);
+    const Eigen::Vector2d lo = la + t * (lb - la), hi = ua + t * (ub - ua);
+    hits += state.in_collision(
+        Eigen::Vector2d(lo[0] + unit(rng) * (hi[0] - lo[0]), lo[1] + unit(rng) * (hi[1] - lo[1])));
+  }
+  EXPECT_LE(hits, 20);
+  std::printf(
+      "two-link post: j2 upper at the start %.4f alone, %.4f on the segment; %d of 20404 checks collide\n",
+      ceiling.upper(alone, 0)[1], ceiling.upper(segment, 0)[1], hits);
+  // The same seed gives the same boxes.
+  RoomCeiling again(scene, {at(-0.6), at(0.6)}, CeilingOptions{});
+  const CeilingExtents repeat = again.grow(again.zero(), true);
+  for (size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(repeat.lo[k], segment.lo[k]);
+    EXPECT_EQ(repeat.hi[k], segment.hi[k]);
+  }
 }
 
 }  // namespace

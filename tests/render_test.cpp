@@ -248,6 +248,35 @@ TEST_F(RenderTest, TurningTheFramedArmChangesManyPixels) {
   EXPECT_GT(near, 3 * far) << near << " " << far;
 }
 
+// One SceneRenderer for many frames draws each as render_scene does, pixel for pixel, whatever it
+// drew before (the volume's geoms are rebuilt from zeros each frame): the arm turned, a box added,
+// ghosts added, and back to the first frame. A request it was not made for is refused.
+TEST_F(RenderTest, OneRendererForManyFramesDrawsEachAsRenderSceneDoes) {
+  const Scene s = scene();
+  std::vector<RenderRequest> frames(4, top_down());
+  frames[1].q[0] = 1.0;
+  frames[2].volume = {beside_the_arm()};
+  frames[2].fade_region = Eigen::AlignedBox3d(Eigen::Vector3d(-2, 1, 0), Eigen::Vector3d(-1, 2, 1));
+  frames[3].ghosts = {Eigen::VectorXd::Constant(1, -0.5), Eigen::VectorXd::Constant(1, 0.5)};
+  frames.push_back(frames[0]);
+  SceneRenderer renderer(s, 160, 120, 1, 2);
+  std::vector<Image> drawn;
+  for (const RenderRequest& r : frames) {
+    drawn.push_back(renderer.render(r));
+    const Image alone = render_scene(s, r);
+    EXPECT_EQ(drawn.back().rgb, alone.rgb) << "frame " << drawn.size() - 1;
+  }
+  EXPECT_NE(drawn[0].rgb, drawn[1].rgb);
+  EXPECT_NE(drawn[0].rgb, drawn[2].rgb);
+  EXPECT_NE(drawn[0].rgb, drawn[3].rgb);
+  RenderRequest bigger = top_down();
+  bigger.width = 200;
+  EXPECT_THROW(renderer.render(bigger), std::logic_error);
+  RenderRequest more = top_down();
+  more.volume = {beside_the_arm(), beside_the_arm()};
+  EXPECT_THROW(renderer.render(more), std::logic_error);
+}
+
 // --volume fade: a box that meets the fade region, or stands between it and the camera, is drawn at
 // the faded opacity; one that does neither at the normal one.
 TEST_F(RenderTest, VolumeBoxesAroundTheRobotAreFaded) {

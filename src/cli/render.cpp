@@ -1,8 +1,10 @@
 #include "cli/render.hpp"
 #include "cli/video.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <memory>
 #include <optional>
 
 #include "core/json_io.hpp"
@@ -321,8 +323,23 @@ struct Painter {
     return c;
   }
 
+  // One renderer for every frame of this size (a video's frames, a strip's): the model copy, the
+  // scene buffer and the OpenGL context are made once.
+  mutable std::unique_ptr<SceneRenderer> renderer;
+  mutable int renderer_width = 0;
+  mutable size_t renderer_ghosts = 0;
+
   Image draw(const std::vector<Frame>& frames, const RenderCamera& c, int frame_width) const {
     std::vector<Image> images;
+    size_t ghosts = 0;
+    for (const Frame& f : frames) ghosts = std::max(ghosts, f.ghosts.size());
+    if (!renderer || renderer_width != frame_width || renderer_ghosts < ghosts) {
+      renderer.reset();  // one OpenGL context at a time
+      renderer = std::make_unique<SceneRenderer>(scene, frame_width, frame_height,
+                                                 show_volume ? in.volume.boxes.size() : 0, ghosts);
+      renderer_width = frame_width;
+      renderer_ghosts = ghosts;
+    }
     for (const Frame& f : frames) {
       RenderRequest request;
       request.width = frame_width;
@@ -334,7 +351,7 @@ struct Painter {
       if (args.volume == "fade")
         request.fade_region =
             Eigen::AlignedBox3d(f.robot.min().array() - kFadeMargin, f.robot.max().array() + kFadeMargin);
-      images.push_back(render_scene(scene, request));
+      images.push_back(renderer->render(request));
     }
     Image image = images.size() == 1 ? images.front() : tile_horizontally(images);
     if (!legend) return image;
@@ -412,7 +429,8 @@ int run_render(const RenderArgs& args) {
   const int k = args.waypoint == -1 ? n - 1 : args.waypoint;
   const std::vector<Frame> frames = render_frames(args, scene, in->bounds, k, ghosts);
 
-  const Painter painter{scene, args, *in, p, show_volume, legend, frame_height, camera_given, camera, lookat};
+  const Painter painter{scene,        args,   *in,    p,       show_volume, legend, frame_height,
+                        camera_given, camera, lookat, nullptr, 0,           0};
   const RenderCamera used = painter.camera_for(frames, frame_width);
   const Image image = painter.draw(frames, used, frame_width);
   write_png(args.out, image);

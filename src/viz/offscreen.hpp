@@ -22,6 +22,9 @@ class OffscreenContext {
   OffscreenContext(const OffscreenContext&) = delete;
   OffscreenContext& operator=(const OffscreenContext&) = delete;
 
+  //! Makes this context the thread's current one (another context made or used since took its
+  //! place): every render through it calls this first.
+  void make_current();
   mjrContext& mjr() { return con_; }
   mjrRect viewport() const { return {0, 0, width_, height_}; }
   //! The offscreen buffer's pixels, rows top to bottom (mjr_readPixels gives them bottom-up).

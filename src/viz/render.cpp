@@ -32,6 +32,10 @@ void check_image_size(int width, int height, const char* what) {
                      " pixels: width and height must be from 16 to 8192");
 }
 
+// The context's window buffer [pixels a side]: only for making it current (MuJoCo renders into its
+// own offscreen framebuffer).
+constexpr int kWindow = 16;
+
 OffscreenContext::OffscreenContext(mjModel& model, int width, int height) : width_(width), height_(height) {
   check_image_size(width, height, "image size");
   install_mujoco_error_handlers();
@@ -40,7 +44,6 @@ OffscreenContext::OffscreenContext(mjModel& model, int width, int height) : widt
   OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 8, nullptr);
   if (!ctx) throw std::runtime_error("OSMesa could not create an OpenGL context");
   osmesa_ = ctx;
-  constexpr int kWindow = 16;
   window_.assign(4 * kWindow * kWindow, 0);
   if (!OSMesaMakeCurrent(ctx, window_.data(), GL_UNSIGNED_BYTE, kWindow, kWindow)) {
     OSMesaDestroyContext(ctx);
@@ -65,7 +68,18 @@ OffscreenContext::OffscreenContext(mjModel& model, int width, int height) : widt
   }
 }
 
+void OffscreenContext::make_current() {
+  if (!OSMesaMakeCurrent(static_cast<OSMesaContext>(osmesa_), window_.data(), GL_UNSIGNED_BYTE, kWindow,
+                         kWindow))
+    throw std::runtime_error("OSMesa could not make its OpenGL context current");
+  mjr_setBuffer(mjFB_OFFSCREEN, &con_);
+}
+
 OffscreenContext::~OffscreenContext() {
+  // mjr_freeContext frees the OpenGL objects of the current context: make it this one.
+  if (con_made_ && osmesa_)
+    OSMesaMakeCurrent(static_cast<OSMesaContext>(osmesa_), window_.data(), GL_UNSIGNED_BYTE, kWindow,
+                      kWindow);
   if (con_made_) mjr_freeContext(&con_);
   if (osmesa_) OSMesaDestroyContext(static_cast<OSMesaContext>(osmesa_));
 }
@@ -490,11 +504,14 @@ Image FrameRenderer::render(const Eigen::VectorXd& q, const std::vector<Eigen::V
                       to.z());
     g.category = mjCAT_DECOR;
   }
+  r.gl->make_current();
   mjr_render(r.gl->viewport(), &r.scn, &r.gl->mjr());
   return r.gl->read();
 }
 
-Image render_scene(const Scene& scene, const RenderRequest& request) {
+namespace {
+
+void check_request(const Scene& scene, const RenderRequest& request) {
   detail::check_image_size(request.width, request.height, "image size");
   check_camera(request.camera);
   scene.validate_configuration(request.q, "rendered configuration");
@@ -504,41 +521,77 @@ Image render_scene(const Scene& scene, const RenderRequest& request) {
     throw InputError("volume opacity " + format_number(request.volume_alpha) + " must be within [0, 1]");
   if (!(request.faded_alpha >= 0 && request.faded_alpha <= 1))
     throw InputError("faded volume opacity " + format_number(request.faded_alpha) + " must be within [0, 1]");
+}
 
+}  // namespace
+
+struct SceneRenderer::Impl {
+  const Scene& scene;
+  int width, height;
+  size_t max_boxes, max_ghosts;
+  ModelPtr model;
+  DataPtr data, ghost;
+  mjvScene scn;
+  bool scn_made = false;
+  std::unique_ptr<detail::OffscreenContext> gl;
+  explicit Impl(const Scene& s) : scene(s) {}
+  ~Impl() {
+    if (scn_made) mjv_freeScene(&scn);
+  }
+};
+
+SceneRenderer::SceneRenderer(const Scene& scene, int width, int height, size_t max_volume_boxes,
+                             size_t max_ghosts)
+    : impl_(std::make_unique<Impl>(scene)) {
+  detail::check_image_size(width, height, "image size");
   install_mujoco_error_handlers();
-  ModelPtr model(mj_copyModel(nullptr, &scene.model()));
-  if (!model) throw std::runtime_error("MuJoCo could not copy the cell's model");
-  mjModel& m = *model;
-  auto pose = [&](const Eigen::VectorXd& q) {
-    DataPtr d = make_data(m);
-    scene.set_qpos(*d, q);
-    mj_kinematics(&m, d.get());
-    mj_camlight(&m, d.get());
-    return d;
+  Impl& r = *impl_;
+  r.width = width;
+  r.height = height;
+  r.max_boxes = max_volume_boxes;
+  r.max_ghosts = max_ghosts;
+  r.model.reset(mj_copyModel(nullptr, &scene.model()));
+  if (!r.model) throw std::runtime_error("MuJoCo could not copy the cell's model");
+  const mjModel& m = *r.model;
+  const double ghost_geoms = static_cast<double>(max_ghosts) * (m.ngeom + m.nsite + 16);
+  const double maxgeom = 1000.0 + m.ngeom + m.nsite + static_cast<double>(max_volume_boxes) + ghost_geoms;
+  if (maxgeom > 50'000'000)
+    throw InputError("too many boxes to render: " + std::to_string(static_cast<long long>(maxgeom)));
+  r.data = make_data(m);
+  r.ghost = make_data(m);
+  mjv_defaultScene(&r.scn);
+  mjv_makeScene(&m, &r.scn, static_cast<int>(maxgeom));
+  r.scn_made = true;
+  r.gl = std::make_unique<detail::OffscreenContext>(*r.model, width, height);
+}
+
+SceneRenderer::~SceneRenderer() = default;
+
+Image SceneRenderer::render(const RenderRequest& request) {
+  Impl& r = *impl_;
+  check_request(r.scene, request);
+  if (request.width != r.width || request.height != r.height || request.volume.size() > r.max_boxes ||
+      request.ghosts.size() > r.max_ghosts)
+    throw std::logic_error("SceneRenderer: a request larger than the renderer was made for");
+  mjModel& m = *r.model;
+  auto pose = [&](mjData& d, const Eigen::VectorXd& q) {
+    r.scene.set_qpos(d, q);
+    mj_kinematics(&m, &d);
+    mj_camlight(&m, &d);
   };
-  DataPtr data = pose(request.q);
+  pose(*r.data, request.q);
 
   mjvOption opt;
   mjv_defaultOption(&opt);
   mjvCamera cam;
   set_camera(request.camera, cam);
-
-  const long ghost_geoms = static_cast<long>(request.ghosts.size()) * (m.ngeom + m.nsite + 16);
-  const long maxgeom = 1000 + m.ngeom + m.nsite + static_cast<long>(request.volume.size()) + ghost_geoms;
-  if (maxgeom > 50'000'000) throw InputError("too many boxes to render: " + std::to_string(maxgeom));
-  mjvScene scn;
-  mjv_defaultScene(&scn);
-  mjv_makeScene(&m, &scn, static_cast<int>(maxgeom));
-  struct SceneFree {
-    mjvScene* s;
-    ~SceneFree() { mjv_freeScene(s); }
-  } free_scene{&scn};
-  mjv_updateScene(&m, data.get(), &opt, nullptr, &cam, mjCAT_ALL, &scn);
+  mjvScene& scn = r.scn;
+  mjv_updateScene(&m, r.data.get(), &opt, nullptr, &cam, mjCAT_ALL, &scn);
   const Eigen::Vector3d campos(scn.camera[0].pos[0], scn.camera[0].pos[1], scn.camera[0].pos[2]);
 
   for (size_t i = 0; i < request.ghosts.size(); ++i) {
-    DataPtr g = pose(request.ghosts[i]);
-    add_ghost(m, *g, opt, campos, i % 2 == 0, scn);
+    pose(*r.ghost, request.ghosts[i]);
+    add_ghost(m, *r.ghost, opt, campos, i % 2 == 0, scn);
   }
 
   // The volume: one box per volume box, coloured by the height of its top.
@@ -559,16 +612,23 @@ Image render_scene(const Scene& scene, const RenderRequest& request) {
     mjvGeom& geom = scn.geoms[scn.ngeom++];
     // mjv_makeScene does not clear its geoms and mjv_initGeom leaves the sorter's fields
     // (camdist, modelrbound, transparent) as they were: start from zeros so that the picture does
-    // not depend on what the heap held before (it did: --threads 1 and 2 gave other PNGs).
+    // not depend on what the heap (or the previous frame) held (it did: --threads 1 and 2 gave
+    // other PNGs).
     geom = mjvGeom{};
     mjv_initGeom(&geom, mjGEOM_BOX, size, pos, mat, rgba);
     geom.category = mjCAT_DECOR;
     if (alpha < 1) mark_transparent(geom, campos);
   }
 
-  detail::OffscreenContext gl(m, request.width, request.height);
-  mjr_render(gl.viewport(), &scn, &gl.mjr());
-  return gl.read();
+  r.gl->make_current();
+  mjr_render(r.gl->viewport(), &scn, &r.gl->mjr());
+  return r.gl->read();
+}
+
+Image render_scene(const Scene& scene, const RenderRequest& request) {
+  check_request(scene, request);
+  SceneRenderer renderer(scene, request.width, request.height, request.volume.size(), request.ghosts.size());
+  return renderer.render(request);
 }
 
 BoundsFileVolume read_bounds_volume(const std::string& path, const Scene& scene, bool require_volume) {

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <array>
+#include <cstddef>
 #include <memory>
 #include <string>
 #include <vector>
@@ -124,6 +125,27 @@ std::vector<Eigen::VectorXd> ghost_configurations(const WaypointBounds& w, Ghost
 //! @throws InputError on an image size outside 16 .. 8192 pixels, a non-finite camera or a bad q;
 //! std::runtime_error when no OpenGL context can be made.
 Image render_scene(const Scene& scene, const RenderRequest& request);
+
+//! Renders many pictures of one scene at one size, as render_scene draws each, through one copy of
+//! the model, one scene buffer and one OpenGL context (render_scene makes them per call): the
+//! frames of `leeway render --video` and `--strip`. One per thread; the scene must outlive it.
+class SceneRenderer {
+ public:
+  //! For requests of `width` x `height` pixels with at most `max_volume_boxes` volume boxes and
+  //! `max_ghosts` ghosts. @throws InputError on a size outside 16 .. 8192 pixels or too many boxes;
+  //! std::runtime_error when no OpenGL context can be made.
+  SceneRenderer(const Scene& scene, int width, int height, size_t max_volume_boxes, size_t max_ghosts);
+  ~SceneRenderer();
+  SceneRenderer(const SceneRenderer&) = delete;
+  SceneRenderer& operator=(const SceneRenderer&) = delete;
+  //! One picture, the same as render_scene(scene, request). @throws InputError as render_scene;
+  //! std::logic_error on a request of another size or with more boxes or ghosts.
+  Image render(const RenderRequest& request);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 //! Renders many frames of one scene through one OpenGL context (a video): the robot at q, up to two
 //! ghosts (tinted as render_scene's) and an arrow. One per thread; the scene must outlive it.

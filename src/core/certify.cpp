@@ -22,8 +22,6 @@ struct Cell {
   int split = -1;  // the joint to split next (set when the cell waits in the heap)
 };
 
-Eigen::Vector3d vec3(const double* p) { return Eigen::Vector3d(p[0], p[1], p[2]); }
-
 void check_box(const Scene& scene, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper) {
   if (lower.size() != scene.dof() || upper.size() != scene.dof())
     throw InputError("certify: a region needs " + std::to_string(scene.dof()) + " joint values per bound");

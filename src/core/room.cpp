@@ -40,11 +40,8 @@ Sweep sweep_of(const Scene& scene, const mjData& d, int i) {
   const mjModel& m = scene.model();
   const RobotJoint& joint = scene.joints()[static_cast<size_t>(i)];
   const int joint_body = m.jnt_bodyid[joint.id];
-  const Eigen::Vector3d anchor(d.xanchor[3 * joint.id], d.xanchor[3 * joint.id + 1],
-                               d.xanchor[3 * joint.id + 2]);
-  const Eigen::Vector3d axis =
-      Eigen::Vector3d(d.xaxis[3 * joint.id], d.xaxis[3 * joint.id + 1], d.xaxis[3 * joint.id + 2])
-          .normalized();
+  const Eigen::Vector3d anchor = vec3(d.xanchor + 3 * joint.id);
+  const Eigen::Vector3d axis = vec3(d.xaxis + 3 * joint.id).normalized();
   Sweep s;
   for (int g : scene.link_geoms()) {
     if (!moves_with(m, m.geom_bodyid[g], joint_body)) continue;

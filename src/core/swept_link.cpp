@@ -7,11 +7,6 @@
 #include <limits>
 
 namespace leeway {
-namespace {
-
-Eigen::Vector3d vec3(const double* p) { return Eigen::Vector3d(p[0], p[1], p[2]); }
-
-}  // namespace
 
 bool touches(const Box& box, double grow, const Box& obstacle, bool plane) {
   Box grown = box;

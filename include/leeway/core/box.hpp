@@ -37,6 +37,9 @@ Eigen::Vector3d closest_point(const Box& box, const Eigen::Vector3d& p);
 double box_distance(const Box& a, const Box& b, Eigen::Vector3d* on_a = nullptr,
                     Eigen::Vector3d* on_b = nullptr);
 
+//! The 3-vector at p[0], p[1], p[2] of a MuJoCo array (d.xanchor + 3 * joint, d.xaxis + 3 * joint, ...).
+inline Eigen::Vector3d vec3(const mjtNum* p) { return Eigen::Vector3d(p[0], p[1], p[2]); }
+
 //! World-frame box of a geom after kinematics: exact for boxes; for other types the box bounds the
 //! geom in its own frame (sphere, capsule, cylinder, ellipsoid), or is the cube of its bounding
 //! sphere (mesh, height field). Planes have no finite box: the returned half-size is infinite.

@@ -22,7 +22,7 @@ import sys
 import tempfile
 
 from machine_info import machine
-from make_room_results import PATHS
+from make_room_results import PATHS, pct
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 DATA = ROOT / "docs" / "data" / "room"
@@ -47,10 +47,6 @@ def measure(leeway, bench, cell, src, dst, folder):
             "segment_from_file": c["segment"]["from_file"], "segment_from_zero": c["segment"]["from_zero"],
             "segment": {k: c["segment"][k] for k in ("mean_share", "joint_share", "start", "check")},
             "seconds": c["seconds"]}
-
-
-def pct(x):
-    return "-" if x is None else f"{100 * x:.1f}"
 
 
 def render(data):

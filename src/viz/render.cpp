@@ -626,7 +626,7 @@ Image SceneRenderer::render(const RenderRequest& request) {
 }
 
 Image render_scene(const Scene& scene, const RenderRequest& request) {
-  check_request(scene, request);
+  check_request(scene, request);  // bad input is refused before an OpenGL context is made
   SceneRenderer renderer(scene, request.width, request.height, request.volume.size(), request.ghosts.size());
   return renderer.render(request);
 }

@@ -9,10 +9,14 @@
 //             to the grown waypoint, the corners of the interpolated box at --slices + 1 evenly
 //             spaced parameters and --samples random (parameter, configuration) pairs.
 // The kept segment-contract bounds are then checked with --check random configurations along the
-// path (another stream), and the collisions found are printed beside the shares.
+// path (another stream), and the collisions found are printed beside the shares. With --certify,
+// they are scaled toward the nominal values by each of the given factors and every segment is
+// given to the certificate (default options, --certify-leaves leaves per segment): how much of the
+// sampled room a proof keeps, and at what cost.
 //
 // Usage: leeway-bench-room-ceiling --cell CELL.xml --bounds BOUNDS.json [--samples 400]
-//          [--slices 8] [--check 20000] [--seed 1] [--json OUT]
+//          [--slices 8] [--check 20000] [--seed 1] [--certify 1,0.75,0.5]
+//          [--certify-leaves 65536] [--json OUT]
 // Prints a Markdown table; --json writes the numbers. Shares are in [0, 1] of the one-joint free
 // range. Exit 2 on bad input.
 #include <algorithm>
@@ -40,7 +44,30 @@ struct Options {
   std::string cell, bounds, json;
   leeway::CeilingOptions ceiling;
   int check = 20000;
+  std::vector<double> certify;  // scales of the segment ceiling given to the certificate
+  long certify_leaves = 65536;
 };
+
+std::vector<double> scales(const std::string& text) {
+  std::vector<double> out;
+  size_t from = 0;
+  while (from <= text.size()) {
+    const size_t comma = std::min(text.find(',', from), text.size());
+    size_t used = 0;
+    const std::string item = text.substr(from, comma - from);
+    double v = NAN;
+    try {
+      v = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != item.size() || !(v >= 0 && v <= 1))
+      throw leeway::InputError("--certify: '" + item + "' is not a scale in [0, 1]");
+    out.push_back(v);
+    from = comma + 1;
+  }
+  return out;
+}
 
 Options parse(int argc, char** argv) {
   Options o;
@@ -64,12 +91,17 @@ Options parse(int argc, char** argv) {
       o.check = std::stoi(value());
     else if (arg == "--seed")
       o.ceiling.seed = std::stoull(value());
+    else if (arg == "--certify")
+      o.certify = scales(value());
+    else if (arg == "--certify-leaves")
+      o.certify_leaves = std::stol(value());
     else
       throw leeway::InputError("unknown option " + arg);
   }
   if (o.cell.empty() || o.bounds.empty()) throw leeway::InputError("--cell and --bounds are needed");
-  if (o.ceiling.samples < 0 || o.ceiling.slices < 1 || o.check < 0)
-    throw leeway::InputError("--samples and --check must not be negative, --slices must be positive");
+  if (o.ceiling.samples < 0 || o.ceiling.slices < 1 || o.check < 0 || o.certify_leaves < 1)
+    throw leeway::InputError(
+        "--samples and --check must not be negative, --slices and --certify-leaves must be positive");
   return o;
 }
 
@@ -79,6 +111,26 @@ nlohmann::json shares_json(const leeway::Scene& scene, const VectorXd& share) {
     j[scene.joints()[static_cast<size_t>(i)].name] =
         std::isnan(share[i]) ? nlohmann::json() : nlohmann::json(share[i]);
   return j;
+}
+
+// The segment ceiling's extents, scaled, given to the certificate: a line each, and out["certify"].
+void certify(const leeway::Scene& scene, const leeway::RoomCeiling& ceiling,
+             const leeway::CeilingExtents& best, const Options& o, nlohmann::json& out) {
+  if (o.certify.empty()) return;
+  const leeway::Certifier certifier(scene, leeway::CertifyOptions{});
+  leeway::CertifyContext ctx(scene);
+  out["certify"] = nlohmann::json::array();
+  for (double scale : o.certify) {
+    const leeway::CeilingProof p = ceiling.certify(best, scale, o.certify_leaves, certifier, ctx);
+    out["certify"].push_back({{"scale", p.scale},
+                              {"mean_share", p.share},
+                              {"segments", p.segments},
+                              {"certified", p.certified},
+                              {"leaves", p.leaves},
+                              {"max_leaves", o.certify_leaves}});
+    std::cout << "| segment x " << scale << ", certified " << p.certified << " of " << p.segments
+              << " segments | | " << p.share << " | " << p.leaves << " leaves | |\n";
+  }
 }
 
 }  // namespace
@@ -129,6 +181,7 @@ int main(int argc, char** argv) {
       if (segment) {
         hits = ceiling.check(best, o.check);
         out[name]["check"] = {{"samples", o.check}, {"collisions", hits}};
+        certify(scene, ceiling, best, o, out);
       }
       std::cout << "| " << name << " | " << best_start << " | " << best_share << " | "
                 << out[name]["joint_share"].dump() << " | "

@@ -18,6 +18,7 @@
 
 #include "core/random.hpp"
 #include "leeway/core/bounds.hpp"
+#include "leeway/core/certify.hpp"
 #include "leeway/core/kinematics.hpp"
 #include "leeway/core/room.hpp"
 #include "leeway/core/scene.hpp"
@@ -34,6 +35,15 @@ struct CeilingOptions {
 //! The extents of every side: per waypoint, lo[i] = q[i] - lower[i], hi[i] = upper[i] - q[i].
 struct CeilingExtents {
   std::vector<Eigen::VectorXd> lo, hi;
+};
+
+//! What the certificate proves of a path's extents scaled toward the nominal values.
+struct CeilingProof {
+  double scale = 1.0;
+  double share = 0.0;  //!< the scaled extents' mean share (RoomCeiling::mean_share)
+  int segments = 0;    //!< segments of the file's contract (one on a one-waypoint path)
+  int certified = 0;   //!< of them, proven free (Certifier::segment_free)
+  long leaves = 0;     //!< the certificate's leaves, all segments
 };
 
 //! The ceiling of one path's room (waypoint or segment contract).
@@ -147,6 +157,32 @@ class RoomCeiling {
       }
     }
     return hits;
+  }
+
+  //! Extents e with every side scaled by `scale` toward the nominal value, and each segment of the
+  //! file's contract under them given to the certifier, on `leaves` leaves each: how much of the
+  //! sampled room a proof keeps, and at what cost.
+  CeilingProof certify(const CeilingExtents& e, double scale, long leaves, const Certifier& certifier,
+                       CertifyContext& ctx) const {
+    CeilingProof proof;
+    proof.scale = scale;
+    CeilingExtents scaled = e;
+    for (size_t k = 0; k < path_.size(); ++k) {
+      scaled.lo[k] *= scale;
+      scaled.hi[k] *= scale;
+    }
+    proof.share = mean_share(scaled);
+    const size_t segments = path_.size() > 1 ? path_.size() - 1 : 1;
+    for (size_t a = 0; a < segments; ++a) {
+      const size_t b = std::min(a + 1, path_.size() - 1);
+      CertifyStats stats;
+      const bool free = certifier.segment_free(ctx, lower(scaled, a), upper(scaled, a), lower(scaled, b),
+                                               upper(scaled, b), CertifyBudget{leaves}, stats);
+      ++proof.segments;
+      proof.certified += free ? 1 : 0;
+      proof.leaves += stats.leaves;
+    }
+    return proof;
   }
 
   size_t waypoints() const { return path_.size(); }

@@ -104,6 +104,34 @@ TEST_F(RoomTest, TheCeilingOfOneWaypointReachesTheWallAndTheLimit) {
   EXPECT_NEAR(ceiling.mean_share(grown), (upper - lower) / (ceiling.free_ranges(0)[0].upper + 3.0), 1e-12);
 }
 
+// The ceiling's extents given to the certificate (RoomCeiling::certify), on the one-link arm: one
+// waypoint at 0.2 rad, 3.2 rad below it (to the limit) and above it to 20 mrad short of the touch
+// angle, where the link's corner is (cos(t) - 0.05 sin(t)) * 0.02 = 6.3 mm from the wall, more than
+// the 1 mm margin: certified. To 20 mrad past the touch angle it is in the wall: not certified; at
+// half those extents it is (0.2 + (kTouch - 0.18) / 2 < kTouch), and the share is half the
+// full extents' (kTouch - 0.18 + 3.2) / (kTouch + 3) (the free range's end is found to 1e-4 rad).
+TEST_F(RoomTest, TheCeilingsBoxesScaledAreGivenToTheCertificate) {
+  RoomCeiling ceiling(*scene_, {box(0.2, 0.2, 0.2)}, CeilingOptions{});
+  const Certifier certifier(*scene_, CertifyOptions{});
+  CertifyContext ctx(*scene_);
+  auto extents = [](double above) {
+    return CeilingExtents{{Eigen::VectorXd::Constant(1, 3.2)}, {Eigen::VectorXd::Constant(1, above)}};
+  };
+  const CeilingProof short_of = ceiling.certify(extents(kTouch - 0.22), 1.0, 65536, certifier, ctx);
+  EXPECT_EQ(short_of.segments, 1);
+  EXPECT_EQ(short_of.certified, 1);
+  EXPECT_GT(short_of.leaves, 0);
+  EXPECT_NEAR(short_of.share, (kTouch - 0.22 + 3.2) / (kTouch + 3.0), 5e-5);
+  const CeilingProof past = ceiling.certify(extents(kTouch - 0.18), 1.0, 65536, certifier, ctx);
+  EXPECT_EQ(past.certified, 0);
+  const CeilingProof half = ceiling.certify(extents(kTouch - 0.18), 0.5, 65536, certifier, ctx);
+  EXPECT_EQ(half.certified, 1);
+  EXPECT_DOUBLE_EQ(half.scale, 0.5);
+  EXPECT_NEAR(half.share, 0.5 * (kTouch - 0.18 + 3.2) / (kTouch + 3.0), 5e-5);
+  // Past the free range's end the share is capped at the whole range.
+  EXPECT_DOUBLE_EQ(past.share, 1.0);
+}
+
 // A planar two-link arm (link 1 of 1 m about z at the base, j1 within [-0.65, 0.65] rad; link 2 of
 // 0.5 m about z at its tip) turning j1 from -0.6 to 0.6 rad with j2 at 0, and a post at 0.9 rad,
 // 1.2 m from the base. Only near the end can link 2 reach the post (from j1 = 0.6 the post is

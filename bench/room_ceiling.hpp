@@ -147,9 +147,9 @@ class RoomCeiling {
     std::mt19937_64 rng(detail::splitmix(o_.seed ^ 0xC4EC4ULL));
     long hits = 0;
     Eigen::VectorXd q(n_);
-    const size_t segments = path_.size() > 1 ? path_.size() - 1 : 1;
+    const size_t segments = segment_count();
     for (size_t a = 0; a < segments; ++a) {
-      const size_t b = std::min(a + 1, path_.size() - 1);
+      const size_t b = segment_end(a);
       for (int j = 0; j < count / static_cast<int>(segments); ++j) {
         detail::draw_in_segment(lower(e, a), upper(e, a), lower(e, b), upper(e, b), detail::unit(rng), rng,
                                 q);
@@ -172,9 +172,8 @@ class RoomCeiling {
       scaled.hi[k] *= scale;
     }
     proof.share = mean_share(scaled);
-    const size_t segments = path_.size() > 1 ? path_.size() - 1 : 1;
-    for (size_t a = 0; a < segments; ++a) {
-      const size_t b = std::min(a + 1, path_.size() - 1);
+    for (size_t a = 0; a < segment_count(); ++a) {
+      const size_t b = segment_end(a);
       CertifyStats stats;
       const bool free = certifier.segment_free(ctx, lower(scaled, a), upper(scaled, a), lower(scaled, b),
                                                upper(scaled, b), CertifyBudget{leaves}, stats);
@@ -193,6 +192,11 @@ class RoomCeiling {
   Eigen::VectorXd upper(const CeilingExtents& e, size_t k) const { return path_[k].q + e.hi[k]; }
 
  private:
+  // The file's contract has a segment between each pair of neighbouring waypoints, and one (the
+  // waypoint at both ends) on a one-waypoint path; segment a ends at waypoint segment_end(a).
+  size_t segment_count() const { return path_.size() > 1 ? path_.size() - 1 : 1; }
+  size_t segment_end(size_t a) const { return std::min(a + 1, path_.size() - 1); }
+
   Eigen::VectorXd free_side(size_t k, bool up) const {
     Eigen::VectorXd v(n_);
     for (int i = 0; i < n_; ++i)

@@ -66,16 +66,14 @@ def render_proofs(rows):
          f"configuration came within the margin: the sampled boxes keep none).", "",
          "| path | " + " | ".join(f"x {x:g}" for x in scales) + " |",
          "|---|" + "---:|" * len(scales)]
+    def whole(p):  # every segment proven
+        return p["certified"] == p["segments"]
+
     for r in rows:
-        cells = [f"{pct(p['mean_share'])} %, {p['leaves']:,}" + ("" if p["certified"] == p["segments"] else " *no*")
-                 for p in r["certify"]]
+        cells = [f"{pct(p['mean_share'])} %, {p['leaves']:,}" + ("" if whole(p) else " *no*") for p in r["certify"]]
         o.append(f"| {r['path']} | " + " | ".join(cells) + " |")
-    best = []
-    for r in rows:
-        proven = [p for p in r["certify"] if p["certified"] == p["segments"]]
-        best.append(max((p["mean_share"] for p in proven), default=0.0))
-    proven_at = {x: sum(1 for r in rows for p in r["certify"] if p["scale"] == x and p["certified"] == p["segments"])
-                 for x in scales}
+    best = [max((p["mean_share"] for p in r["certify"] if whole(p)), default=0.0) for r in rows]
+    proven_at = {x: sum(1 for r in rows for p in r["certify"] if p["scale"] == x and whole(p)) for x in scales}
     o += ["", f"- Paths proven free whole at each factor: "
           + ", ".join(f"x {x:g}: {proven_at[x]}" for x in scales) + f" (of {len(rows)}).",
           f"- The largest share proven per path, median over the paths: {pct(statistics.median(best))} % "

@@ -530,6 +530,53 @@ TEST_P(CertifyPropertyTest, GrownSlabsOfCertifiedBoxesAreFree) {
   }
 }
 
+// Boxes whose last three joints (the wrist) turn far, up to +-pi, around centres near the
+// keyframes, the other joints up to 0.05: where the pivot boxes make the difference
+// (docs/algorithm.md, "Pivot boxes"). Whenever region_free certifies one, sampling finds no
+// configuration within the margin; some must be certified that the certifier without pivot boxes
+// does not certify on the same budget, or the test says nothing about them.
+TEST_P(CertifyPropertyTest, WideWristRegionsCertifiedWithPivotBoxesAreFree) {
+  SCOPED_TRACE(trace());
+  const Scene& scene = *scene_;
+  if (scene.dof() < 4) GTEST_SKIP() << "no wrist";
+  RegionSource src = source(1000037u, 4);
+  RobotState state(scene);
+  CertifyOptions opt, without;
+  opt.max_leaves = without.max_leaves = 256;
+  without.pivot_boxes = false;
+  const Certifier certifier(scene, opt), plain(scene, without);
+  CertifyContext ctx(scene);
+  const int count = this->count(4);
+  int certified = 0, only_with = 0, failures = 0;
+  for (int r = 0; r < count && failures < 3; ++r) {
+    const Eigen::VectorXd c = src.centre(2);
+    Eigen::VectorXd h(scene.dof());
+    const double wide = src.uniform(0.3, 3.2);
+    for (int i = 0; i < h.size(); ++i)
+      h[i] = i >= scene.dof() - 3 ? src.uniform(0.5, 1.0) * wide : src.uniform(0, 0.05);
+    const Eigen::VectorXd lower = (c - h).cwiseMax(scene.lower_limits()),
+                          upper = (c + h).cwiseMin(scene.upper_limits());
+    if (!((lower.array() <= upper.array()).all())) continue;
+    CertifyStats stats;
+    if (!certifier.region_free(ctx, lower, upper, stats)) continue;
+    ++certified;
+    CertifyStats plain_stats;
+    if (!plain.region_free(ctx, lower, upper, plain_stats)) ++only_with;
+    const Violation v = sample_segment(state, src, lower, upper, lower, upper, 300, opt.margin);
+    if (!v.found) continue;
+    ++failures;
+    ADD_FAILURE() << "wide wrist region " << r << " certified: lower " << vec_str(lower) << " upper "
+                  << vec_str(upper) << "\n  but " << describe(scene, v);
+  }
+  std::cout << "[ certify  ] " << cell_ << ": " << certified << " of " << count
+            << " wide wrist regions certified, " << only_with << " only with pivot boxes\n";
+  // (The folding hand's fingers, on slides after its wrist, leave it almost no wide region.)
+  if (sampled_enough(count) && cell_ != "folding_hand") {
+    EXPECT_GT(certified, 0) << "the property is vacuous";
+    EXPECT_GT(only_with, 0) << "no region needed the pivot boxes";
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(CertifyCells, CertifyPropertyTest,
                          ::testing::Values("dallara", "baltico", "dlr", "rail_hall", "wide_elbow", "one_link",
                                            "hammer", "telescope", "folding_hand"));
@@ -1137,6 +1184,117 @@ TEST_F(CertifyTest, FoldingArmCertifiedUpToItsElbowTouchMinusTheMargin) {
   }
   // The corner probes of a box that is also wide in j1 cost a few more leaves; the proof is the same.
   EXPECT_LE(leaves[1], 2 * leaves[0]) << "a turn of j1 made the proof harder";
+}
+
+// A plate (0.8 x 0.6 x 0.01 m) spinning about its normal (hinge j1 about z through its centre at
+// height 0.5 m) beside a post whose near face is x = 0.52: the plate's corners stay 0.5 m from the
+// axis, so at every angle the post is 2 cm away. The pivot box of j1 (the cylinder the plate sweeps:
+// radius 0.5 m, 1 cm thick, in a box with axes z, -y, x) proves a whole turn in one leaf, 2 cm less
+// 0.5 m = 0.02 m clear along x; the plate's own bound cannot (a corner moves up to 0.5 m/rad). With
+// the post's face at x = 0.5005 the corner comes within 0.5 mm at j1 = -atan(0.3 / 0.4): nothing is
+// certified.
+std::string spinning_plate_cell(double face) {
+  return R"(<mujoco model="spinning-plate">
+  <compiler angle="radian" autolimits="true"/>
+  <worldbody>
+    <body name="plate" pos="0 0 0.5">
+      <joint name="j1" type="hinge" axis="0 0 1" range="-3.2 3.2"/>
+      <geom name="plate_box" type="box" size="0.4 0.3 0.005"/>
+      <site name="tool0" pos="0.4 0 0"/>
+    </body>
+    <geom name="post" type="box" size="0.08 0.5 0.5" pos=")" +
+         std::to_string(face + 0.08) + R"( 0 0.5"/>
+  </worldbody>
+</mujoco>
+)";
+}
+
+TEST_F(CertifyTest, SpinningPlateIsCertifiedByTheCylinderItSweeps) {
+  test::TempDir dir;
+  const Scene scene = Scene::load(dir.write("cell.xml", spinning_plate_cell(0.52)));
+  RobotState state(scene);
+  EXPECT_NEAR(exact_clearance(state, v1(-std::atan(0.75))).distance, 0.02, 1e-9);
+  CertifyOptions without;
+  without.pivot_boxes = false;
+  const Certifier certifier(scene), plain(scene, without);
+  CertifyContext ctx(scene);
+  CertifyStats stats;
+  EXPECT_TRUE(certifier.leaf_free(ctx, v1(-3.1), v1(3.1), stats));
+  EXPECT_EQ(stats.leaves, 1);
+  stats = {};
+  EXPECT_FALSE(plain.leaf_free(ctx, v1(-3.1), v1(3.1), stats));
+
+  const Scene close = Scene::load(dir.write("close.xml", spinning_plate_cell(0.5005)));
+  RobotState close_state(close);
+  EXPECT_NEAR(exact_clearance(close_state, v1(-std::atan(0.75))).distance, 0.0005, 1e-9);
+  const Certifier close_certifier(close);
+  CertifyContext close_ctx(close);
+  stats = {};
+  EXPECT_FALSE(close_certifier.region_free(close_ctx, v1(-3.1), v1(3.1), stats));
+}
+
+// A spherical wrist at P = (0, 0, 1): j1 about x, j2 about y and j3 about x, all three axes through
+// P, and a tool box 0.4 x 0.2 x 0.04 m from 0.2 to 0.6 m along j3's axis. Every point of the tool
+// keeps its distance from P, at most sqrt(0.6^2 + 0.1^2 + 0.02^2) = 0.608605 m (the far corners),
+// whatever the three joints do. Over a table whose top is z = 0.38 (0.62 m below P), the ball's
+// pivot box proves all three joints over +-3.1 rad in one leaf, 1.14 cm clear; the tool's own bound
+// cannot. With the top at z = 0.45 the tool pointing down (j2 = pi/2) reaches z = 0.4, into the table:
+// not certified.
+std::string spherical_wrist_cell(double top) {
+  return R"(<mujoco model="spherical-wrist">
+  <compiler angle="radian" autolimits="true"/>
+  <worldbody>
+    <body name="b1" pos="0 0 1">
+      <joint name="j1" type="hinge" axis="1 0 0" range="-3.2 3.2"/>
+      <inertial pos="0 0 0" mass="1" diaginertia="0.01 0.01 0.01"/>
+      <body name="b2">
+        <joint name="j2" type="hinge" axis="0 1 0" range="-3.2 3.2"/>
+        <inertial pos="0 0 0" mass="1" diaginertia="0.01 0.01 0.01"/>
+        <body name="b3" pos="0.1 0 0">
+          <joint name="j3" type="hinge" axis="1 0 0" range="-3.2 3.2"/>
+          <geom name="tool_box" type="box" size="0.2 0.1 0.02" pos="0.3 0 0"/>
+          <site name="tool0" pos="0.5 0 0"/>
+        </body>
+      </body>
+    </body>
+    <geom name="table" type="box" size="0.5 0.5 0.1" pos="0 0 )" +
+         std::to_string(top - 0.1) + R"("/>
+  </worldbody>
+</mujoco>
+)";
+}
+
+TEST_F(CertifyTest, SphericalWristIsCertifiedByTheBallItStaysIn) {
+  test::TempDir dir;
+  const Scene scene = Scene::load(dir.write("cell.xml", spherical_wrist_cell(0.38)));
+  const Eigen::VectorXd lower = Eigen::VectorXd::Constant(3, -3.1), upper = -lower;
+  CertifyOptions without;
+  without.pivot_boxes = false;
+  const Certifier certifier(scene), plain(scene, without);
+  CertifyContext ctx(scene);
+  CertifyStats stats;
+  EXPECT_TRUE(certifier.leaf_free(ctx, lower, upper, stats));
+  EXPECT_EQ(stats.leaves, 1);
+  stats = {};
+  EXPECT_FALSE(plain.leaf_free(ctx, lower, upper, stats));
+  // The ball is what proves it: 1.14 cm of clearance, so a margin of 1.1 cm passes and 1.2 cm not.
+  for (const auto& [margin, free] : {std::pair{0.011, true}, std::pair{0.012, false}}) {
+    CertifyOptions opt;
+    opt.margin = margin;
+    const Certifier c(scene, opt);
+    stats = {};
+    EXPECT_EQ(c.leaf_free(ctx, lower, upper, stats), free) << "margin " << margin;
+  }
+
+  const Scene high = Scene::load(dir.write("high.xml", spherical_wrist_cell(0.45)));
+  RobotState high_state(high);
+  Eigen::VectorXd down(3);
+  down << 0, M_PI / 2, 0;
+  EXPECT_TRUE(high_state.in_collision(down));
+  const Certifier high_certifier(high);
+  CertifyContext high_ctx(high);
+  stats = {};
+  EXPECT_FALSE(high_certifier.region_free(high_ctx, lower, upper, stats));
 }
 
 }  // namespace

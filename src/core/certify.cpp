@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -50,12 +51,14 @@ bool out_of_leaves(const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, C
 // inequality over the offsets of the chain: the anchor's offset in its body, every later body's
 // position in its parent, the shift of a body's origin by its own joints (a later hinge: at most
 // twice its anchor offset; a later slide: its longest travel from the reference position within its
-// limits) and the geom's position in its body. Rotations keep lengths.
-double chain_lever(const Scene& scene, int geom, const std::vector<int>& bodies, const std::vector<int>& jids,
-                   const std::vector<size_t>& body_of_joint, const std::vector<int>& robot_index, size_t p) {
+// limits) and x's offset `offset` in the last body. Rotations keep lengths. Only the first
+// `joint_end` joints and `body_end` bodies count (x is fixed on bodies[body_end - 1]).
+double chain_lever(const Scene& scene, const std::vector<int>& bodies, const std::vector<int>& jids,
+                   const std::vector<size_t>& body_of_joint, const std::vector<int>& robot_index, size_t p,
+                   size_t joint_end, size_t body_end, double offset) {
   const mjModel& m = scene.model();
   double lever = vec3(m.jnt_pos + 3 * jids[p]).norm();
-  for (size_t q = p + 1; q < jids.size(); ++q) {
+  for (size_t q = p + 1; q < joint_end; ++q) {
     const int later = jids[q];
     lever += 2 * vec3(m.jnt_pos + 3 * later).norm();
     if (m.jnt_type[later] == mjJNT_SLIDE) {
@@ -64,10 +67,24 @@ double chain_lever(const Scene& scene, int geom, const std::vector<int>& bodies,
       lever += std::max(std::abs(joint.lower - ref), std::abs(joint.upper - ref));
     }
   }
-  for (size_t k = body_of_joint[p] + 1; k < bodies.size(); ++k)
-    lever += vec3(m.body_pos + 3 * bodies[k]).norm();
-  lever += vec3(m.geom_pos + 3 * geom).norm();
-  return lever;
+  for (size_t k = body_of_joint[p] + 1; k < body_end; ++k) lever += vec3(m.body_pos + 3 * bodies[k]).norm();
+  return lever + offset;
+}
+
+// The eight corners of a box.
+std::array<Eigen::Vector3d, 8> corners_of(const Box& b) {
+  std::array<Eigen::Vector3d, 8> out;
+  for (int i = 0; i < 8; ++i) {
+    const Eigen::Vector3d sign((i & 1) ? 1.0 : -1.0, (i & 2) ? 1.0 : -1.0, (i & 4) ? 1.0 : -1.0);
+    out[static_cast<size_t>(i)] = b.center + b.rotation * sign.cwiseProduct(b.half_size);
+  }
+  return out;
+}
+
+// Distance from point x to the line through o along unit a.
+double line_distance(const Eigen::Vector3d& x, const Eigen::Vector3d& o, const Eigen::Vector3d& a) {
+  const Eigen::Vector3d v = x - o;
+  return (v - a.dot(v) * a).norm();
 }
 
 // The bodies from `body` up to the world (excluded), tip first.
@@ -130,10 +147,97 @@ void Certifier::add_links(RobotState& state) {
       link.joints.push_back(r);
       link.mj_joints.push_back(jids[p]);
       link.slide.push_back(scene.joints()[static_cast<size_t>(r)].prismatic);
-      link.lever.push_back(chain_lever(scene, g, bodies, jids, body_of_joint, robot_index, p));
+      link.lever.push_back(chain_lever(scene, bodies, jids, body_of_joint, robot_index, p, jids.size(),
+                                       bodies.size(), vec3(m.geom_pos + 3 * g).norm()));
     }
     link.corner_lever = std::isfinite(b0.half_size.norm()) ? b0.half_size.norm() : 0.0;
+    pivots_of_.emplace_back();
+    if (std::isfinite(link.corner_lever)) add_pivots(state, link, bodies, jids, body_of_joint, robot_index);
     links_.push_back(std::move(link));
+  }
+}
+
+// Pivot boxes of a link (docs/algorithm.md, "Pivot boxes"), at the reference configuration of
+// `state`: a box on the last hinge's body that holds the cylinder the geom sweeps about that hinge,
+// and a cube about the point where a hinge's axis meets every later hinge's (a spherical wrist),
+// which holds the ball the geom stays in whatever those joints do.
+void Certifier::add_pivots(const RobotState& state, const LinkChain& link, const std::vector<int>& bodies,
+                           const std::vector<int>& jids, const std::vector<size_t>& body_of_joint,
+                           const std::vector<int>& robot_index) {
+  const mjModel& m = scene_->model();
+  const mjData& d = state.data();
+  const size_t n = jids.size();
+  const std::array<Eigen::Vector3d, 8> corners = corners_of(geom_box(m, d, link.geom));
+  auto frame_of = [&](int body) {
+    return Eigen::Matrix3d(Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(d.xmat + 9 * body));
+  };
+  // A hinge that is its body's only joint: the body's frame turns about it and nothing else.
+  auto pivot_hinge = [&](size_t k) {
+    return m.jnt_type[jids[k]] == mjJNT_HINGE && m.body_jntnum[m.jnt_bodyid[jids[k]]] == 1;
+  };
+  auto add = [&](size_t k, const Eigen::Vector3d& centre, const Eigen::Matrix3d& axes,
+                 const Eigen::Vector3d& half, bool translate_only) {
+    LinkChain pivot = link;
+    const int body = m.jnt_bodyid[jids[k]];
+    pivot.body = body;
+    pivot.frozen_from = k;
+    pivot.local_pos = frame_of(body).transpose() * (centre - vec3(d.xpos + 3 * body));
+    pivot.local_rot = frame_of(body).transpose() * axes;
+    pivot.half_size = half;
+    pivot.translate_only = translate_only;
+    pivot.corner_lever = half.norm();
+    for (size_t p = 0; p < k; ++p)
+      pivot.lever[p] = chain_lever(*scene_, bodies, jids, body_of_joint, robot_index, p, k + 1,
+                                   body_of_joint[k] + 1, pivot.local_pos.norm());
+    pivots_of_.back().push_back(static_cast<int>(pivots_.size()));
+    pivots_.push_back(std::move(pivot));
+  };
+  // The cylinder about the last hinge: the geom is fixed in that hinge's body.
+  if (n > 0 && pivot_hinge(n - 1)) {
+    const size_t k = n - 1;
+    const Eigen::Vector3d a = vec3(d.xaxis + 3 * jids[k]).normalized();
+    const Eigen::Vector3d o = vec3(d.xanchor + 3 * jids[k]);
+    double zmin = INFINITY, zmax = -INFINITY, radial = 0;
+    for (const Eigen::Vector3d& c : corners) {
+      const double z = a.dot(c - o);
+      zmin = std::min(zmin, z);
+      zmax = std::max(zmax, z);
+      radial = std::max(radial, line_distance(c, o, a));
+    }
+    Eigen::Matrix3d axes;
+    axes.col(0) = a;
+    axes.col(1) = a.unitOrthogonal();
+    axes.col(2) = a.cross(axes.col(1));
+    add(k, o + a * (zmin + zmax) / 2, axes, Eigen::Vector3d((zmax - zmin) / 2, radial, radial), false);
+  }
+  // The ball about a spherical wrist: the most proximal hinge k whose axis meets the next one's at a
+  // point P that lies on every later axis, all of them hinges. Every later rotation keeps P fixed,
+  // so each point of the geom stays at its distance from P. (A turn about an axis that misses P by d
+  // moves a point at most 2 d further from P: axes that miss it by more than a nanometre in all are
+  // not used, and 1 micrometre, far more than the rounding and such misses can add, goes on the
+  // radius.)
+  for (size_t k = 0; k + 1 < n; ++k) {
+    bool hinges = pivot_hinge(k);
+    for (size_t j = k + 1; j < n && hinges; ++j) hinges = m.jnt_type[jids[j]] == mjJNT_HINGE;
+    if (!hinges) continue;
+    const Eigen::Vector3d a = vec3(d.xaxis + 3 * jids[k]).normalized(), o = vec3(d.xanchor + 3 * jids[k]);
+    const Eigen::Vector3d b = vec3(d.xaxis + 3 * jids[k + 1]).normalized(),
+                          ob = vec3(d.xanchor + 3 * jids[k + 1]);
+    const double sine = a.cross(b).norm();
+    if (sine < 1e-6) continue;
+    // The point of axis k nearest to axis k + 1.
+    const Eigen::Vector3d w = o - ob;
+    const double ab = a.dot(b), s = (ab * b.dot(w) - a.dot(w)) / (1 - ab * ab);
+    const Eigen::Vector3d centre = o + s * a;
+    double miss = 0;
+    for (size_t j = k + 1; j < n; ++j)
+      miss += line_distance(centre, vec3(d.xanchor + 3 * jids[j]), vec3(d.xaxis + 3 * jids[j]).normalized());
+    if (miss > 1e-9) continue;
+    double radius = 0;
+    for (const Eigen::Vector3d& c : corners) radius = std::max(radius, (c - centre).norm());
+    radius += 1e-6;
+    add(k, centre, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Constant(radius), true);
+    break;
   }
 }
 
@@ -257,6 +361,31 @@ void Certifier::describe_failure(const CertifyContext& ctx, const Eigen::VectorX
   failure.budget = false;
 }
 
+// Whether one of link li's pivot boxes, swept over the leaf (its first `held` joints held, as the
+// link's own bound), stays more than the margin from `obs`: then so does the link.
+bool Certifier::pivot_separates(CertifyContext& ctx, int li, int held, const SweepObstacle& obs) const {
+  const mjModel& m = scene_->model();
+  const mjData& d = ctx.state_.data();
+  const std::vector<int>& mine = pivots_of_[static_cast<size_t>(li)];
+  for (size_t slot = 0; slot < mine.size(); ++slot) {
+    const int v = mine[slot];
+    const LinkChain& pivot = pivots_[static_cast<size_t>(v)];
+    SweptLink& sweep = ctx.pivot_sweep_[slot];
+    auto& [last_v, last_held] = ctx.pivot_last_[slot];
+    if (last_v != v || last_held != held) {
+      last_v = v;
+      last_held = held;
+      sweep.start(pivot, v, ctx.half_, held, m, d);
+    }
+    if (!obs.plane &&
+        (obs.box.center - sweep.box().center).norm() - sweep.cheap_radius() - obs.radius > options_.margin)
+      return true;
+    sweep.build();
+    if (separate(sweep, obs, options_.margin).separated) return true;
+  }
+  return false;
+}
+
 // One leaf: every pair in `pairs` is tested at the box's centre c with half-widths h; on return
 // `pairs` holds the pairs that could not be separated (empty: the box is free). Every pair is
 // tested, not only up to the first failing one: the worst-first order needs the worst gap.
@@ -273,6 +402,10 @@ bool Certifier::leaf_free_impl(CertifyContext& ctx, const Eigen::VectorXd& lower
   const size_t nobs = obstacles_.size();
   SweptLink& sweep = ctx.sweep_;
   sweep.new_leaf();
+  for (size_t slot = 0; slot < 2; ++slot) {
+    ctx.pivot_sweep_[slot].new_leaf();
+    ctx.pivot_last_[slot] = {-1, 0};
+  }
   ctx.failing_.clear();
   int last_link = -1, last_held = 0;
   if (failure) {
@@ -313,6 +446,7 @@ bool Certifier::leaf_free_impl(CertifyContext& ctx, const Eigen::VectorXd& lower
       sep = separate(sweep, obs, margin);
     }
     if (sep.separated) continue;
+    if (options_.pivot_boxes && !options_.bound && pivot_separates(ctx, li, held, obs)) continue;
     if (failure) {
       failure->gap = std::min(failure->gap, std::isfinite(sep.gap) ? sep.gap - margin : -1e9);
       if (ctx.failing_.empty()) describe_failure(ctx, lower, upper, obs, self, sep, blame_weights, *failure);

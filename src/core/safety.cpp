@@ -490,12 +490,15 @@ SegmentSafety sample_segment(RobotState& state, Extents& e, size_t a, size_t b, 
 }
 
 // The certifier's options: each segment counts its leaves from zero (its own CertifyStats) up to
-// segment_leaf_budget, passed to each call.
-CertifyOptions certify_options(const SafetyParams& params, const SweepBound* bound) {
+// segment_leaf_budget, passed to each call. Pivot boxes only for a sparse path's growth: the
+// shrink and regrow keep the guide's narrow wrist, where they cost more time than they prove, and
+// the dense growth's time limits were measured without them (docs/algorithm.md, "Pivot boxes").
+CertifyOptions certify_options(const SafetyParams& params, const SweepBound* bound, bool pivot_boxes) {
   CertifyOptions options;
   options.margin = params.margin;
   options.max_leaves = params.max_leaves;
   options.bound = bound;
+  options.pivot_boxes = pivot_boxes;
   return options;
 }
 
@@ -528,7 +531,7 @@ SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, 
   for (size_t s = 0; s + 1 < bounds.size(); ++s) short_count += is_short(e, s, s + 1) ? 1 : 0;
   const bool dense = 2 * short_count >= segments && segments > 1;
   if (params.mode == SafetyMode::kCertified) {
-    const Certifier certifier(scene, certify_options(params, bound));
+    const Certifier certifier(scene, certify_options(params, bound, false));
     const long leaf_limit = segment_leaf_budget(params);
     const Extents guide(bounds);
     // Segment s writes waypoints s and s + 1 and, regrowing them, reads its neighbours' (s - 1 and
@@ -603,9 +606,10 @@ SafetyReport make_safe(const Scene& scene, std::vector<WaypointBounds>& bounds, 
   // as one box, since waypoint by waypoint it cost several times the certified mode's work
   // (docs/algorithm.md, "Growing"). The caps apply to every path.
   if (params.mode == SafetyMode::kCertified && (params.grow != "none" || !params.max_half_width.empty())) {
-    report.grow =
-        dense ? grow_dense(scene, bounds, report.segments, params, certify_options(params, bound), threads)
-              : grow_bounds(scene, bounds, report.segments, params, certify_options(params, bound), threads);
+    report.grow = dense ? grow_dense(scene, bounds, report.segments, params,
+                                     certify_options(params, bound, false), threads)
+                        : grow_bounds(scene, bounds, report.segments, params,
+                                      certify_options(params, bound, true), threads);
     report.stats.add(report.grow.stats);
   }
   report.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

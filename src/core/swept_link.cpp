@@ -23,14 +23,29 @@ void SweptLink::start(const LinkChain& link, int link_id, const Eigen::VectorXd&
   link_ = &link;
   d_ = &d;
   held_ = held;
-  hl_ = h;
+  const size_t n = link.joints.size();
+  // A pivot box holds what its frozen entries sweep: they are held at the centre.
+  const Eigen::VectorXd* hv = &h;
+  if (link.body >= 0) {
+    tail_held_ = h;
+    for (size_t p = link.frozen_from; p < n; ++p) tail_held_[link.joints[p]] = 0;
+    hv = &tail_held_;
+    const Eigen::Vector3d origin = vec3(d.xpos + 3 * link.body);
+    const Eigen::Matrix3d frame =
+        Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(d.xmat + 9 * link.body);
+    box_.center = origin + frame * link.local_pos;
+    box_.rotation =
+        link.translate_only ? Eigen::Matrix3d::Identity() : Eigen::Matrix3d(frame * link.local_rot);
+    box_.half_size = link.half_size;
+  } else {
+    box_ = geom_box(m, d, link.geom);
+  }
+  hl_ = *hv;
   for (int p = 0; p < held; ++p) hl_[link.joints[static_cast<size_t>(p)]] = 0;
-  box_ = geom_box(m, d, link.geom);
   built_ = false;
   // The remainder's isotropic size, and a sphere around x(c) that holds the swept link without
   // the Jacobian (|d x / d q_p| <= lever_p, 1 for a slide): most pairs are separated by it, and
   // the full bound (build()) is built only for the pairs it does not separate.
-  const size_t n = link.joints.size();
   // Term p of these sums involves only joints p and later, so with the first `held` joints held
   // (their terms zero) the others are the same as for the whole link: they are built once per
   // link and leaf, not once per self pair group (a link on a long chain has as many groups as
@@ -44,12 +59,12 @@ void SweptLink::start(const LinkChain& link, int link_id, const Eigen::VectorXd&
     for (size_t p = 0; p < n; ++p) {
       const int rp = link.joints[p];
       const bool slide_p = link.slide[p];
-      iso_term_[p] = h[rp] * (slide_p ? 1.0 : link.lever[p]);
+      iso_term_[p] = (*hv)[rp] * (slide_p ? 1.0 : link.lever[p]);
       if (slide_p) continue;
       for (size_t q = p; q < n; ++q) {
         const int rq = link.joints[q];
         const bool slide = link.slide[q];
-        const double coef = (p == q ? 0.5 : 1.0) * h[rp] * h[rq];
+        const double coef = (p == q ? 0.5 : 1.0) * (*hv)[rp] * (*hv)[rq];
         full_r_pos_[p] += coef * (slide ? 1.0 : link.lever[q]);
         if (!slide) full_r_rot_[p] += coef;
       }
@@ -63,7 +78,7 @@ void SweptLink::start(const LinkChain& link, int link_id, const Eigen::VectorXd&
     iso_cheap_ += iso_term_[p];
     if (link.slide[p]) continue;
     r_pos_[p] = full_r_pos_[p];
-    r_rot_[p] = full_r_rot_[p];
+    r_rot_[p] = link.translate_only ? 0.0 : full_r_rot_[p];
     rem_iso_ += r_pos_[p];
   }
   iso_cheap_ += rem_iso_;
@@ -87,7 +102,8 @@ void SweptLink::build() {
       lever_radius_ += hl_[r];
     } else {
       jac_[p] = a.cross(box_.center - vec3(d.xanchor + 3 * jid));
-      for (int k = 0; k < 3; ++k) axis_jac_[p].col(k) = a.cross(box_.rotation.col(k));
+      if (!link.translate_only)
+        for (int k = 0; k < 3; ++k) axis_jac_[p].col(k) = a.cross(box_.rotation.col(k));
       lever_radius_ += hl_[r] * (link.lever[p] + link.corner_lever);
     }
   }
@@ -128,7 +144,7 @@ void SweptLink::build() {
     const double hp = hl_[link.joints[p]];
     if (hp == 0) continue;
     motion_.col(col++) = hp * jac_[p];
-    if (link.slide[p]) continue;
+    if (link.slide[p] || link.translate_only) continue;
     for (int k = 0; k < 3; ++k) motion_.col(col++) = (hp * box_.half_size[k]) * axis_jac_[p].col(k);
   }
   motion_cols_ = col;
@@ -154,7 +170,8 @@ void SweptLink::build_terms() {
       t.iso = slide ? 1.0 : l.lever[q];
       t.var = t.iso * (theta_before_[p] + theta_before_[q]) + (slide ? 0.0 : dv_[q]);
       t.slide = slide;
-      if (!slide) {
+      t.turns_axes = !slide && !l.translate_only;
+      if (t.turns_axes) {
         for (int k = 0; k < 3; ++k) t.we.col(k) = axis_[p].cross(axis_[q].cross(box_.rotation.col(k)));
         t.var_e = theta_before_[p] + theta_before_[q] + theta_;
       }
@@ -194,7 +211,7 @@ double SweptLink::remainder_refined(const Eigen::Vector3d& n) {
   for (const Term& t : terms_) {
     const double sp = t.p < np ? s_p[t.p] : 1.0;
     rem_pos += t.coef * std::min(sp * t.iso, std::abs(n.dot(t.w)) + t.var);
-    if (!t.slide)
+    if (t.turns_axes)
       for (int k = 0; k < 3; ++k) rem_rot[k] += t.coef * std::min(sp, std::abs(n.dot(t.we.col(k))) + t.var_e);
   }
   return rem_pos + box_.half_size.dot(rem_rot);

@@ -26,6 +26,10 @@ struct CertifyOptions {
   //! Another bound than the Taylor bound for every pair (tests and benchmarks compare the loose
   //! lever-arm reference through it); null: the Taylor bound. Not owned: it outlives the Certifier.
   const SweepBound* bound = nullptr;
+  //! A pair the link's own bound cannot separate over a leaf is also tried with the link's pivot
+  //! boxes (docs/algorithm.md, "Pivot boxes"): they make a wide wrist cheap to prove, and cost a
+  //! leaf more where the wrist is narrow.
+  bool pivot_boxes = true;
 };
 
 //! The work one call may do, passed to each call (never stored in the certifier).
@@ -73,6 +77,8 @@ class CertifyContext {
   const Scene* scene_;
   RobotState state_;
   SweptLink sweep_;
+  SweptLink pivot_sweep_[2];                // a link's pivot boxes (at most two), and
+  std::pair<int, int> pivot_last_[2] = {};  // which box and held count each was started for
   Eigen::VectorXd centre_, half_;
   std::vector<int> failing_;
 };
@@ -170,6 +176,9 @@ class Certifier {
   };
 
   void add_links(RobotState& state);
+  void add_pivots(const RobotState& state, const LinkChain& link, const std::vector<int>& bodies,
+                  const std::vector<int>& jids, const std::vector<size_t>& body_of_joint,
+                  const std::vector<int>& robot_index);
   void add_self_pairs();
   void index_pairs();
   //! A self pair's other geom at the leaf's centre, grown by what its own free joints move it.
@@ -178,6 +187,7 @@ class Certifier {
   void describe_failure(const CertifyContext& ctx, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
                         const SweepObstacle& obs, bool self, const Separation& sep,
                         const Eigen::VectorXd* blame_weights, CertifyFailure& failure) const;
+  bool pivot_separates(CertifyContext& ctx, int li, int held, const SweepObstacle& obs) const;
   bool leaf_free_impl(CertifyContext& ctx, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
                       std::vector<int>& pairs, CertifyStats& stats, CertifyFailure* failure,
                       const Eigen::VectorXd* blame_weights = nullptr) const;
@@ -200,6 +210,10 @@ class Certifier {
   const Scene* scene_;
   CertifyOptions options_;
   std::vector<LinkChain> links_;
+  //! Pivot boxes (LinkChain::body >= 0), and per link the indices of its own: a pair its box
+  //! cannot separate over a leaf is proven when one of them separates it.
+  std::vector<LinkChain> pivots_;
+  std::vector<std::vector<int>> pivots_of_;
   std::vector<SweepObstacle> obstacles_;
   std::vector<SelfPair> self_pairs_;
   int obstacle_pairs_ = 0;  //!< pair indices below it are (link, obstacle), link-major; the rest self pairs

@@ -23,6 +23,18 @@ struct LinkChain {
   std::vector<bool> slide;     //!< per entry: a prismatic joint
   std::vector<double> lever;   //!< per entry: bound of |x - o_j| over all configurations [m]
   double corner_lever = 0.0;   //!< bound of |corner - x| of the geom's box [m]
+  //! A pivot box (body >= 0) instead of the geom's own box: a box fixed on `body`, the body of
+  //! chain entry `frozen_from` (a hinge), that holds the geom at every value of that joint and of
+  //! every later one. Entries from `frozen_from` on are then held at the leaf's centre: the box
+  //! holds what they sweep. docs/algorithm.md ("Pivot boxes") gives the two kinds and why each holds.
+  int body = -1;
+  size_t frozen_from = 0;
+  Eigen::Vector3d local_pos = Eigen::Vector3d::Zero();      //!< the box's centre in `body`'s frame [m]
+  Eigen::Matrix3d local_rot = Eigen::Matrix3d::Identity();  //!< its axes in `body`'s frame
+  Eigen::Vector3d half_size = Eigen::Vector3d::Zero();      //!< its half sizes [m]
+  //! The box keeps the world's axes (it holds a ball, whose orientation does not matter): only its
+  //! centre moves, so the bound has no terms for turning box axes.
+  bool translate_only = false;
 };
 
 //! What a link is tested against: an obstacle's (or another robot geom's) box.
@@ -47,7 +59,8 @@ class SweptLink {
   //! A new leaf: forgets what start() cached for the previous one.
   void new_leaf() { cached_link_ = -1; }
   //! Starts the bound of `link` (index `link_id`, for the cache) over half-widths `h` (per robot
-  //! joint) about the configuration of `d`, its first `held` joints held at the centre.
+  //! joint) about the configuration of `d`, its first `held` joints held at the centre (and, for a
+  //! pivot box, its entries from frozen_from on).
   void start(const LinkChain& link, int link_id, const Eigen::VectorXd& h, int held, const mjModel& m,
              const mjData& d);
   //! The link's box at the centre.
@@ -85,6 +98,7 @@ class SweptLink {
     size_t p = 0;
     double coef = 0, iso = 0, var = 0, var_e = 0;
     bool slide = false;
+    bool turns_axes = false;  // the term turns the box's axes (a hinge q, a box that turns)
     Eigen::Vector3d w = Eigen::Vector3d::Zero();
     Eigen::Matrix3d we = Eigen::Matrix3d::Zero();
   };
@@ -104,6 +118,7 @@ class SweptLink {
   std::vector<double> dv_;                 // per joint q: |v_q(q) - v_q(c)|
   std::vector<double> r_pos_, r_rot_;      // per joint p: the remainder terms (p, q >= p)
   std::vector<Term> terms_;
+  Eigen::VectorXd tail_held_;  // h with a pivot box's frozen entries zeroed
   // r_pos, r_rot and the isotropic terms of the link `cached_link_` with no joint held.
   std::vector<double> full_r_pos_, full_r_rot_, iso_term_;
   int cached_link_ = -1;

@@ -131,8 +131,7 @@ double box_distance(const Box& a, const Box& b, Eigen::Vector3d* on_a, Eigen::Ve
 Box geom_box(const mjModel& m, const mjData& d, int geom) {
   Box b;
   b.center = Eigen::Map<const Eigen::Vector3d>(d.geom_xpos + 3 * geom);
-  // MuJoCo stores xmat row-major.
-  b.rotation = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(d.geom_xmat + 9 * geom);
+  b.rotation = mat3(d.geom_xmat + 9 * geom);
   const double* s = m.geom_size + 3 * geom;
   switch (m.geom_type[geom]) {
     case mjGEOM_BOX:

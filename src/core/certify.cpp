@@ -81,6 +81,13 @@ std::array<Eigen::Vector3d, 8> corners_of(const Box& b) {
   return out;
 }
 
+// Whether the sphere that holds the swept link without the Jacobian (SweptLink::cheap_radius) and
+// the obstacle's bounding sphere are more than `margin` apart (never for a plane).
+bool apart_by_spheres(const SweptLink& sweep, const SweepObstacle& obs, double margin) {
+  return !obs.plane &&
+         (obs.box.center - sweep.box().center).norm() - sweep.cheap_radius() - obs.radius > margin;
+}
+
 // Distance from point x to the line through o along unit a.
 double line_distance(const Eigen::Vector3d& x, const Eigen::Vector3d& o, const Eigen::Vector3d& a) {
   const Eigen::Vector3d v = x - o;
@@ -168,9 +175,7 @@ void Certifier::add_pivots(const RobotState& state, const LinkChain& link, const
   const mjData& d = state.data();
   const size_t n = jids.size();
   const std::array<Eigen::Vector3d, 8> corners = corners_of(geom_box(m, d, link.geom));
-  auto frame_of = [&](int body) {
-    return Eigen::Matrix3d(Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(d.xmat + 9 * body));
-  };
+  auto frame_of = [&](int body) { return mat3(d.xmat + 9 * body); };
   // A hinge that is its body's only joint: the body's frame turns about it and nothing else.
   auto pivot_hinge = [&](size_t k) {
     return m.jnt_type[jids[k]] == mjJNT_HINGE && m.body_jntnum[m.jnt_bodyid[jids[k]]] == 1;
@@ -377,9 +382,7 @@ bool Certifier::pivot_separates(CertifyContext& ctx, int li, int held, const Swe
       last_held = held;
       sweep.start(pivot, v, ctx.half_, held, m, d);
     }
-    if (!obs.plane &&
-        (obs.box.center - sweep.box().center).norm() - sweep.cheap_radius() - obs.radius > options_.margin)
-      return true;
+    if (apart_by_spheres(sweep, obs, options_.margin)) return true;
     sweep.build();
     if (separate(sweep, obs, options_.margin).separated) return true;
   }
@@ -433,9 +436,7 @@ bool Certifier::leaf_free_impl(CertifyContext& ctx, const Eigen::VectorXd& lower
       sweep.start(links_[static_cast<size_t>(li)], li, ctx.half_, held, m, d);
     }
     // Most pairs are apart by more than the sphere that holds the swept link without the Jacobian.
-    if (!options_.bound && !obs.plane &&
-        (obs.box.center - sweep.box().center).norm() - sweep.cheap_radius() - obs.radius > margin)
-      continue;
+    if (!options_.bound && apart_by_spheres(sweep, obs, margin)) continue;
     sweep.build();
     Separation sep;
     if (options_.bound) {

@@ -31,8 +31,7 @@ void SweptLink::start(const LinkChain& link, int link_id, const Eigen::VectorXd&
     for (size_t p = link.frozen_from; p < n; ++p) tail_held_[link.joints[p]] = 0;
     hv = &tail_held_;
     const Eigen::Vector3d origin = vec3(d.xpos + 3 * link.body);
-    const Eigen::Matrix3d frame =
-        Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(d.xmat + 9 * link.body);
+    const Eigen::Matrix3d frame = mat3(d.xmat + 9 * link.body);
     box_.center = origin + frame * link.local_pos;
     box_.rotation =
         link.translate_only ? Eigen::Matrix3d::Identity() : Eigen::Matrix3d(frame * link.local_rot);
@@ -169,7 +168,6 @@ void SweptLink::build_terms() {
                   : Eigen::Vector3d(axis_[p].cross(axis_[q].cross(box_.center - anchor)));
       t.iso = slide ? 1.0 : l.lever[q];
       t.var = t.iso * (theta_before_[p] + theta_before_[q]) + (slide ? 0.0 : dv_[q]);
-      t.slide = slide;
       t.turns_axes = !slide && !l.translate_only;
       if (t.turns_axes) {
         for (int k = 0; k < 3; ++k) t.we.col(k) = axis_[p].cross(axis_[q].cross(box_.rotation.col(k)));

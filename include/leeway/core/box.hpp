@@ -39,6 +39,10 @@ double box_distance(const Box& a, const Box& b, Eigen::Vector3d* on_a = nullptr,
 
 //! The 3-vector at p[0], p[1], p[2] of a MuJoCo array (d.xanchor + 3 * joint, d.xaxis + 3 * joint, ...).
 inline Eigen::Vector3d vec3(const mjtNum* p) { return Eigen::Vector3d(p[0], p[1], p[2]); }
+//! The rotation matrix MuJoCo stores row-major at p (d.xmat + 9 * body, d.geom_xmat + 9 * geom, ...).
+inline Eigen::Matrix3d mat3(const mjtNum* p) {
+  return Eigen::Map<const Eigen::Matrix<mjtNum, 3, 3, Eigen::RowMajor>>(p);
+}
 
 //! World-frame box of a geom after kinematics: exact for boxes; for other types the box bounds the
 //! geom in its own frame (sphere, capsule, cylinder, ellipsoid), or is the cube of its bounding

@@ -97,7 +97,6 @@ class SweptLink {
   struct Term {
     size_t p = 0;
     double coef = 0, iso = 0, var = 0, var_e = 0;
-    bool slide = false;
     bool turns_axes = false;  // the term turns the box's axes (a hinge q, a box that turns)
     Eigen::Vector3d w = Eigen::Vector3d::Zero();
     Eigen::Matrix3d we = Eigen::Matrix3d::Zero();

@@ -1085,6 +1085,32 @@ TEST_F(CertifyTest, NarrowBoundsSegmentIsCertifiedWithinTheBudget) {
   }
 }
 
+// A slab that grows end a of a certified segment on kRailCell: the carriage's upper bound goes
+// from 0.1 to 0.2 m at a, while at b it stays at 0.79 m (the slab has zero width there). By hand:
+// every configuration of the slab lies in [0.1, 0.79], whose front face reaches 0.99 m, 1 cm clear
+// of the plate, and leaf_free proves that box in one leaf. Told that joint 0 is the slab's, the
+// certificate does not cut the path where the slab thins (one leaf); as a plain segment, the thin
+// end is cut into ever shorter stretches. The slab widened to 0.81 m at a reaches the plate.
+TEST_F(CertifyTest, SlabIsNotCutWhereItThins) {
+  test::TempDir dir;
+  const Scene scene = Scene::load(dir.write("rail.xml", kRailCell));
+  Certifier certifier(scene);
+  CertifyContext ctx(scene);
+  CertifyStats stats;
+  EXPECT_TRUE(certifier.leaf_free(ctx, v1(0.1), v1(0.79), stats));
+  EXPECT_EQ(stats.leaves, 1);
+  stats = {};
+  EXPECT_TRUE(certifier.segment_free(ctx, v1(0.1), v1(0.2), v1(0.79), v1(0.79), stats, nullptr, nullptr, 0));
+  EXPECT_EQ(stats.leaves, 1);
+  stats = {};
+  EXPECT_TRUE(certifier.segment_free(ctx, v1(0.1), v1(0.2), v1(0.79), v1(0.79), stats));
+  EXPECT_GT(stats.leaves, 8);
+  CertifyFailure failure;
+  EXPECT_FALSE(
+      certifier.segment_free(ctx, v1(0.1), v1(0.81), v1(0.79), v1(0.79), stats, &failure, nullptr, 0));
+  EXPECT_EQ(scene.geom_label(failure.obstacle_geom), "plate");
+}
+
 TEST_F(CertifyTest, HingeBeforeASlideIsBoundedWithTheSlidesTravel) {
   test::TempDir dir;
   const Scene scene = Scene::load(dir.write("telescope.xml", kTelescopeCell));

@@ -637,8 +637,14 @@ bool Certifier::segment_free(CertifyContext& ctx, const Eigen::VectorXd& lower_a
     const Eigen::VectorXd motion = ((lo1 + hi1) - (lo0 + hi0)).cwiseAbs() / 2;
     const Eigen::VectorXd half = ((hi0 - lo0).cwiseMin(hi1 - lo1)) / 2;
     // (An absolute floor keeps zero-width bounds, whose box is the path's own motion, from being
-    // split without end: 5 mrad or 5 mm of motion is left to the box.)
-    const bool dominated = (motion.array() > 0.5 * half.array() + 0.005).any();
+    // split without end: 5 mrad or 5 mm of motion is left to the box.) A slab's own joint does not
+    // count: the slab tapers to zero width at the segment's other end, where the rule would cut the
+    // path into ever shorter stretches, each proving the whole box of the other joints there again
+    // (the hull stays a sound bound whatever the stretch's length; a stretch that fails is still
+    // split below).
+    Eigen::VectorXd counted = motion;
+    if (grown_joint >= 0) counted[grown_joint] = 0;
+    const bool dominated = (counted.array() > 0.5 * half.array() + 0.005).any();
     if (splittable && dominated) {
       const double tm = (t0 + t1) / 2;
       stack.push_back({tm, t1});

@@ -470,6 +470,11 @@ int grown_intervals(const std::vector<WaypointBounds>& bounds) {
 
 bool any(const std::vector<bool>& mask) { return std::find(mask.begin(), mask.end(), true) != mask.end(); }
 
+// A leaf budget times safety.grow_leaves, at least one leaf.
+long scaled(long leaves, double factor) {
+  return std::max(1L, static_cast<long>(std::llround(static_cast<double>(leaves) * factor)));
+}
+
 }  // namespace
 
 GrowReport grow_bounds(const Scene& scene, std::vector<WaypointBounds>& bounds,
@@ -502,17 +507,19 @@ GrowReport grow_bounds(const Scene& scene, std::vector<WaypointBounds>& bounds,
   // blocked[k][2 i + side]: that side stopped short in an earlier round.
   std::vector<std::vector<char>> blocked(count, std::vector<char>(static_cast<size_t>(2 * n), 0));
   std::vector<CertifyStats> stats(count);
-  const long slab_leaves = params.max_leaves / kSlabBudgetDivisor;
+  const long slab_leaves = scaled(params.max_leaves / kSlabBudgetDivisor, params.grow_leaves);
   const Certifier certifier(scene, options);
   // Each waypoint may spend on growing as many leaves as its segments took to certify (half of each:
   // a segment has two ends), so growth about doubles the certified mode's work at most.
   // A floor of safety.max_leaves, so that a path certified at once can still grow.
+  // safety.grow_leaves scales both.
   std::vector<long> budget(count, static_cast<long>(params.max_leaves));
   for (size_t s = 0; s < segments.size(); ++s) {
     const long half = segments[s].leaves / 2;
     budget[s] += count == 1 ? segments[s].leaves : half;
     if (s + 1 < count) budget[s + 1] += half;
   }
+  for (long& b : budget) b = scaled(b, params.grow_leaves);
   // A waypoint's slabs read its neighbours' bounds: even waypoints grow in parallel, then odd ones.
   for (double fraction : lever ? kLeverFractions : kRoundFractions)
     for (size_t parity = 0; parity < 2; ++parity) {
@@ -569,7 +576,9 @@ GrowReport grow_dense(const Scene& scene, std::vector<WaypointBounds>& bounds,
         const size_t g = jobs[static_cast<size_t>(job)];
         const size_t first = g * kBlockSegments, last = std::min(first + kBlockSegments, count - 1);
         // An odd block's ends belong to the even blocks beside it (the path's last waypoint does not).
-        DenseBlock block{certifier, *ctx, bounds, before, segments, mask, caps, params.max_leaves, stats[g]};
+        DenseBlock block{certifier, *ctx, bounds, before,
+                         segments,  mask, caps,   scaled(params.max_leaves, params.grow_leaves),
+                         stats[g]};
         block.grow(first, last, parity == 1, parity == 1 && last + 1 < count);
       };
     });

@@ -65,6 +65,7 @@ void for_each_field(P& p, F&& f) {
   f("safety", "grow", p.safety.grow);
   f("safety", "max_half_width", p.safety.max_half_width);
   f("safety", "shape", p.safety.shape);
+  f("safety", "grow_leaves", p.safety.grow_leaves);
   f("safety", "runs", p.safety.runs);
 }
 
@@ -269,6 +270,7 @@ void Params::validate() const {
                      " must be none, sampled or certified");
   require_between("safety.margin", safety.margin, 0.0, 1.0);
   require_between("safety.max_leaves", safety.max_leaves, 1, 100000000);
+  require_between("safety.grow_leaves", safety.grow_leaves, 0.01, 1000.0);
   require_between("safety.epsilon", safety.epsilon, 1e-9, 0.5);
   require_between("safety.delta", safety.delta, 1e-12, 0.5);
   if (safety.grow.empty())

@@ -132,6 +132,9 @@ struct SafetyParams {
   //! "lever" (one pass, the joint whose kept share costs the tool least motion first, each side
   //! straight to its target).
   std::string shape = "greedy";
+  //! Certified mode: growth's leaf budgets (each slab's and each waypoint's or block's in all) as a
+  //! multiple of their defaults; more buys room with time (docs/results.md, "Room for time").
+  double grow_leaves = 1.0;
   //! Certified mode, dense paths: a warm segment inside its chain's run box (one proven box for up
   //! to 16 waypoints ahead) needs no proof of its own, and a chain does not retry a widening the
   //! certificate refused (docs/algorithm.md, "Run boxes"); false: every segment is proven on its

@@ -126,6 +126,52 @@ TEST_F(GrowTest, OneLinkGrowsToTheWallLessTheMarginAndToTheLimitOnTheFreeSide) {
   EXPECT_GE(sampled_clearance(scene, b, 20000), 0.001 - 1e-9);
 }
 
+// Growth to a joint limit writes the limit itself: with the range +-3.14159 and the nominal value
+// 0.9, 0.9 - (0.9 + 3.14159) is -3.1415900000000004 in doubles, beyond the limit, and a bounds file
+// whose interval leaves the limits is refused.
+TEST_F(GrowTest, GrowthToAJointLimitStaysWithinIt) {
+  std::string cell = test::one_link_cell(kWall);
+  const std::string range = R"(range="-3 3")";
+  cell.replace(cell.find(range), range.size(), R"(range="-3.14159 3.14159")");
+  const Scene scene = Scene::load(dir_.write("one_link_pi.xml", cell));
+  ASSERT_LT(0.9 - (0.9 + 3.14159), -3.14159);
+  std::vector<WaypointBounds> b = {box(v1(0.9), v1(0.8), v1(1.0))};
+  const SafetyReport r = make_safe(scene, b, SafetyParams{});
+  ASSERT_TRUE(r.all_passed);
+  EXPECT_EQ(b[0].lower[0], -3.14159);
+  EXPECT_LE(b[0].upper[0], kTouch - kWithinMargin + 1e-9);
+  EXPECT_GE(b[0].upper[0], kTouch - kWithinMargin - 0.005);
+}
+
+// safety.grow_leaves multiplies growth's leaf budgets: on the one-link arm with
+// safety.max_leaves = 64, growth runs out of leaves far short of the wall (analytic touch less the
+// margin, 1.1963 rad) and of the free side's limit (-3 rad); with four times the budgets it reaches
+// both, within 5 mrad and never beyond, and the grown region stays clear by the margin.
+TEST_F(GrowTest, LargerGrowthBudgetsReachTheWallLessTheMargin) {
+  const Scene scene = Scene::load(dir_.write("one_link.xml", test::one_link_cell(kWall)));
+  const std::vector<WaypointBounds> guide = {box(v1(0.0), v1(-0.1), v1(0.1)), box(v1(0.3), v1(0.2), v1(0.4))};
+  SafetyParams params;
+  params.max_leaves = 64;
+  std::vector<WaypointBounds> b = guide;
+  const SafetyReport small = make_safe(scene, b, params);
+  ASSERT_TRUE(small.all_passed);
+  for (const auto& w : b) {
+    EXPECT_LT(w.upper[0], kTouch - kWithinMargin - 0.005);
+    EXPECT_GT(w.lower[0], -3.0 + 0.005);
+  }
+  params.grow_leaves = 4;
+  b = guide;
+  const SafetyReport large = make_safe(scene, b, params);
+  ASSERT_TRUE(large.all_passed);
+  for (const auto& w : b) {
+    EXPECT_LE(w.upper[0], kTouch - kWithinMargin + 1e-9);
+    EXPECT_GE(w.upper[0], kTouch - kWithinMargin - 0.005);
+    EXPECT_EQ(w.lower[0], -3.0);
+  }
+  EXPECT_GT(large.grow.stats.leaves, small.grow.stats.leaves);
+  EXPECT_GE(sampled_clearance(scene, b, 20000), 0.001 - 1e-9);
+}
+
 TEST_F(GrowTest, TwoLinkElbowGrowsToItsTouchLessTheMarginWhenOnlyItGrows) {
   const Scene scene = Scene::load(dir_.write("two_link.xml", kTwoLink));
   // One waypoint; j1 held at its nominal value (a zero-width interval) and not grown.

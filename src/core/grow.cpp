@@ -128,8 +128,7 @@ class WaypointGrowth {
     return side ? w.upper[i] - w.q[i] : w.q[i] - w.lower[i];
   }
   void set(int i, int side, double extent) {
-    WaypointBounds& w = b_[k_];
-    (side ? w.upper[i] : w.lower[i]) = side ? w.q[i] + extent : w.q[i] - extent;
+    (side ? b_[k_].upper[i] : b_[k_].lower[i]) = bound(i, side, extent);
   }
 
  private:
@@ -161,7 +160,7 @@ class WaypointGrowth {
       for (int end = 0; end < 2; ++end) {
         const WaypointBounds& w = b_[end ? r : p];
         const double old_bound = side ? w.upper[i] : w.lower[i];
-        const double new_bound = (end ? r : p) != k_ ? old_bound : side ? w.q[i] + to : w.q[i] - to;
+        const double new_bound = (end ? r : p) != k_ ? old_bound : bound(i, side, to);
         lo[end][i] = side ? old_bound : new_bound;
         hi[end][i] = side ? new_bound : old_bound;
       }
@@ -169,6 +168,15 @@ class WaypointGrowth {
       if (!free) break;
     }
     return free;
+  }
+
+  // This waypoint's bound of joint i on `side` at `extent` from the nominal value, within the
+  // joint's limits: q + (limit - q) may pass the limit by a rounding error, and a bounds file
+  // whose interval leaves the limits is refused.
+  double bound(int i, int side, double extent) const {
+    const RobotJoint& joint = certifier_.scene().joints()[static_cast<size_t>(i)];
+    const double q = b_[k_].q[i];
+    return side ? std::min(joint.upper, q + extent) : std::max(joint.lower, q - extent);
   }
 
   const Certifier& certifier_;

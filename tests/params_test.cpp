@@ -82,6 +82,7 @@ Params unusual() {
   p.safety.grow = "j4,j6";
   p.safety.max_half_width = {{"j6", 0.25}};
   p.safety.shape = "lever";
+  p.safety.grow_leaves = 2.5;
   p.safety.runs = false;
   p.cf.windows = 12;
   p.cf.samples = 500;
@@ -120,6 +121,7 @@ void expect_equal(const Params& a, const Params& b) {
   EXPECT_EQ(a.safety.grow, b.safety.grow);
   EXPECT_EQ(a.safety.max_half_width, b.safety.max_half_width);
   EXPECT_EQ(a.safety.shape, b.safety.shape);
+  EXPECT_EQ(a.safety.grow_leaves, b.safety.grow_leaves);
   EXPECT_EQ(a.safety.runs, b.safety.runs);
   EXPECT_EQ(a.cf.windows, b.cf.windows);
   EXPECT_EQ(a.cf.samples, b.cf.samples);
@@ -145,7 +147,9 @@ TEST(ParamsJsonTest, KeysAreTheFieldNames) {
   EXPECT_EQ(j.at("bounds").at("linear_axis_tolerance"), 0.05);
   EXPECT_EQ(j.at("cf").at("seed"), 18446744073709551615ull);
   EXPECT_EQ(j.size(), 6u);
-  EXPECT_EQ(j.at("safety").size(), 10u);
+  EXPECT_EQ(j.at("safety").size(), 11u);
+  EXPECT_EQ(j.at("safety").at("grow_leaves"), 2.5);
+  EXPECT_EQ(to_json(Params{}).at("safety").at("grow_leaves"), 1.0);
   EXPECT_EQ(j.at("safety").at("runs"), false);
   EXPECT_EQ(to_json(Params{}).at("safety").at("runs"), true);
   EXPECT_EQ(j.at("safety").at("mode"), "certified");
@@ -331,6 +335,9 @@ TEST(ParamsValidateTest, EachInvalidValueNamesItsKey) {
       {"'bounds.wrist_half_width'", [](Params& p) { p.bounds.wrist_half_width = -0.2; }},
       {"'bounds.linear_axis_tolerance'", [](Params& p) { p.bounds.linear_axis_tolerance = -0.01; }},
       {"'bounds.linear_axis_tolerance'", [](Params& p) { p.bounds.linear_axis_tolerance = 1.5; }},
+      {"'safety.grow_leaves'", [](Params& p) { p.safety.grow_leaves = 0.0; }},
+      {"'safety.grow_leaves'", [](Params& p) { p.safety.grow_leaves = 1001.0; }},
+      {"'safety.grow_leaves'", [=](Params& p) { p.safety.grow_leaves = nan; }},
       {"'cf.windows'", [](Params& p) { p.cf.windows = 0; }},
       {"'cf.samples'", [](Params& p) { p.cf.samples = 0; }},
   };

@@ -137,7 +137,7 @@ def main():
         o.append(room.read_text())
     # The shape of growth, greedy against lever: tools/shape_study.py writes it; the ceiling of the
     # room measure: tools/room_ceiling.py. Their notes are hand-written.
-    for name in ("shape.md", "shape_notes.md", "ceiling.md", "ceiling_notes.md"):
+    for name in ("shape.md", "shape_notes.md", "budget.md", "budget_notes.md", "ceiling.md", "ceiling_notes.md"):
         shape = ROOT / "docs" / "data" / "room" / name
         if shape.exists():
             o.append(shape.read_text())

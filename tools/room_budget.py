@@ -88,7 +88,7 @@ def render(data):
          "`--params P`, P = `{\"safety\": {\"grow_leaves\": F}}`, two runs at a time; `leeway cf --self` "
          "(300,000 samples) on each bounds file. *Share* = room.mean_share, the mean over the joints of each "
          "joint's kept share of its one-joint free range [%]; *j1-j3 drop* = the largest drop of a path's "
-         "j1-j3 share below `--grow none`'s [points]; *safety* = timing_ms.safety summed over the paths [s] "
+         "j1-j3 share below `--grow none`'s [points] (negative: every path keeps more); *safety* = timing_ms.safety summed over the paths [s] "
          "(one thread each). Raw numbers: `docs/data/room/budget.json`.", "",
          "| configuration | median share [%] | mean share [%] | j1-j3 drop [points] | safety [s] | x `--grow none` | certified | collisions / samples |",
          "|---|---:|---:|---:|---:|---:|---:|---:|"]

@@ -59,6 +59,13 @@ double probe_limit(double ok, double bad, double tolerance, Probe probe) {
   return ok - 2 * tolerance;
 }
 
+// The bound of a joint on `side` (1: upper) at `extent` from its nominal value q, within the joint's
+// limits: q + (limit - q) may pass the limit by a rounding error, and a bounds file whose interval
+// leaves the limits is refused.
+double limited_bound(const RobotJoint& joint, double q, int side, double extent) {
+  return side ? std::min(joint.upper, q + extent) : std::max(joint.lower, q - extent);
+}
+
 // The certificate's part of one growth step from `extent` to the probe's `candidate`, for a
 // waypoint or a block: a thin slab first, on a small budget (when it cannot be proven, the thicker
 // ones cannot either, almost always, and a failing slab costs its whole budget), then the whole
@@ -170,13 +177,9 @@ class WaypointGrowth {
     return free;
   }
 
-  // This waypoint's bound of joint i on `side` at `extent` from the nominal value, within the
-  // joint's limits: q + (limit - q) may pass the limit by a rounding error, and a bounds file
-  // whose interval leaves the limits is refused.
+  // This waypoint's bound of joint i on `side` at `extent` from the nominal value.
   double bound(int i, int side, double extent) const {
-    const RobotJoint& joint = certifier_.scene().joints()[static_cast<size_t>(i)];
-    const double q = b_[k_].q[i];
-    return side ? std::min(joint.upper, q + extent) : std::max(joint.lower, q - extent);
+    return limited_bound(certifier_.scene().joints()[static_cast<size_t>(i)], b_[k_].q[i], side, extent);
   }
 
   const Certifier& certifier_;
@@ -324,9 +327,9 @@ class BlockGrowth {
   // Waypoint k's bound of joint i on `side` widened to `extent`, within the joint's limits.
   double widened(size_t k, int i, int side, double extent) const {
     const WaypointBounds& w = b_[k];
-    const RobotJoint& joint = certifier_.scene().joints()[static_cast<size_t>(i)];
-    return side ? std::max(w.upper[i], std::min(joint.upper, w.q[i] + extent))
-                : std::min(w.lower[i], std::max(joint.lower, w.q[i] - extent));
+    const double to =
+        limited_bound(certifier_.scene().joints()[static_cast<size_t>(i)], w.q[i], side, extent);
+    return side ? std::max(w.upper[i], to) : std::min(w.lower[i], to);
   }
 
   // The slab the growth adds to the hull, joint i from the hull's edge to the new one.

@@ -135,8 +135,9 @@ def main():
     room = ROOT / "docs" / "data" / "room" / "section.md"
     if room.exists():
         o.append(room.read_text())
-    # The shape of growth, greedy against lever: tools/shape_study.py writes it; the ceiling of the
-    # room measure: tools/room_ceiling.py. Their notes are hand-written.
+    # The shape of growth, greedy against lever: tools/shape_study.py writes it; room for time:
+    # tools/room_budget.py; the ceiling of the room measure: tools/room_ceiling.py. Their notes are
+    # hand-written.
     for name in ("shape.md", "shape_notes.md", "budget.md", "budget_notes.md", "ceiling.md", "ceiling_notes.md"):
         shape = ROOT / "docs" / "data" / "room" / name
         if shape.exists():

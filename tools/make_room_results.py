@@ -60,6 +60,24 @@ def measure(leeway, cell, src, dst, extra, folder):
             "obstacle_collisions": cf["obstacle_collisions"], "self_collisions": cf["self_collisions"]}
 
 
+def study_data():
+    """A room study's data before its paths: today's date, this machine and the checked-out commit."""
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                            cwd=ROOT).stdout.strip()
+    return {"date": datetime.date.today().isoformat(), "machine": machine(), "commit": commit, "paths": []}
+
+
+def write_study(path, data, render):
+    """Writes a study's raw numbers to `path` (unless `data` is None: render only), its section,
+    render(the numbers), beside it as .md, and prints the section."""
+    if data is not None:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(data, indent=1) + "\n")
+    text = render(json.loads(path.read_text()))
+    path.with_suffix(".md").write_text(text)
+    print(text, end="")
+
+
 def pct(x):
     return "-" if x is None else f"{100 * x:.1f}"
 
@@ -128,9 +146,7 @@ def main():
     DATA.mkdir(parents=True, exist_ok=True)
     if not args.render_only:
         paths = [tuple(p.split("/")) for p in args.paths.split(",")] if args.paths else PATHS
-        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
-                                cwd=ROOT).stdout.strip()
-        data = {"date": datetime.date.today().isoformat(), "machine": machine(), "commit": commit, "paths": []}
+        data = study_data()
         with tempfile.TemporaryDirectory() as folder:
             for cell, src, dst in paths:
                 row = {"path": f"{cell} {src}-{dst}"}

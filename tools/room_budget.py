@@ -17,17 +17,14 @@ safety.certified, cf's obstacle_collisions and self_collisions.
 """
 import argparse
 import concurrent.futures
-import datetime
 import json
 import pathlib
 import statistics
-import subprocess
 import sys
 import tempfile
 
-from machine_info import machine
-# The 15 sparse paths and the share format of the room study, one list for all room studies.
-from make_room_results import PATHS, pct
+# The 15 sparse paths, the share format and the helpers of the room study, one copy for all studies.
+from make_room_results import PATHS, pct, run_json, study_data, write_study
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 DATA = ROOT / "docs" / "data" / "room" / "budget.json"
@@ -35,13 +32,6 @@ DATA = ROOT / "docs" / "data" / "room" / "budget.json"
 TARGET_SHARE = 0.30
 MAX_J13_DROP = 0.02
 MAX_TIME_RATIO = 2.0
-
-
-def run_json(cmd):
-    out = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT)
-    if out.returncode != 0:
-        raise RuntimeError(f"{' '.join(cmd)}: exit {out.returncode}: {out.stderr.strip()}")
-    return json.loads(out.stdout)
 
 
 def measure(leeway, folder, path, config, extra):
@@ -116,12 +106,11 @@ def main():
     ap.add_argument("--factors", default="1,2,4,8,16")
     ap.add_argument("--render-only", action="store_true")
     args = ap.parse_args()
+    data = None
     if not args.render_only:
         factors = [float(f) for f in args.factors.split(",")]
-        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
-                                cwd=ROOT).stdout.strip()
-        data = {"date": datetime.date.today().isoformat(), "machine": machine(), "commit": commit,
-                "factors": factors, "paths": []}
+        data = study_data()
+        data["factors"] = factors
         with tempfile.TemporaryDirectory() as folder:
             configs = {"none": ["--grow", "none"]}
             for f in factors:
@@ -140,11 +129,7 @@ def main():
                 print(f"{row['path']}: " + ", ".join(f"{c} {pct(row[c]['mean_share'])} %" for c in configs),
                       file=sys.stderr)
                 data["paths"].append(row)
-        DATA.parent.mkdir(parents=True, exist_ok=True)
-        DATA.write_text(json.dumps(data, indent=1) + "\n")
-    text = render(json.loads(DATA.read_text()))
-    DATA.with_suffix(".md").write_text(text)
-    print(text, end="")
+    write_study(DATA, data, render)
 
 
 if __name__ == "__main__":

@@ -17,17 +17,14 @@ j1-j3 share (their mean) drops by more than 2 points, and the safety stage over 
 at most twice greedy's time.
 """
 import argparse
-import datetime
 import json
 import pathlib
 import statistics
-import subprocess
 import sys
 import tempfile
 
-from machine_info import machine
-# The 15 sparse paths and the share format of the room study, one list for both studies.
-from make_room_results import PATHS, pct
+# The 15 sparse paths, the share format and the helpers of the room study, one copy for all studies.
+from make_room_results import PATHS, pct, run_json, study_data, write_study
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 DATA = ROOT / "docs" / "data" / "room" / "shape.json"
@@ -37,12 +34,8 @@ MAX_TIME_RATIO = 2.0
 
 
 def measure(leeway, cell, src, dst, params_file):
-    cmd = [leeway, "bounds", f"mjcf/workcells/{cell}.xml", "--from", src, "--to", dst, "--room", "on",
-           "--json", "--threads", "1", "--params", str(params_file)]
-    out = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT)
-    if out.returncode != 0:
-        raise RuntimeError(f"{' '.join(cmd)}: exit {out.returncode}: {out.stderr.strip()}")
-    b = json.loads(out.stdout)
+    b = run_json([leeway, "bounds", f"mjcf/workcells/{cell}.xml", "--from", src, "--to", dst, "--room", "on",
+                  "--json", "--threads", "1", "--params", str(params_file)])
     room = b["room"]
     js = room["joint_share"]
     return {"mean_share": room["mean_share"], "j1": js["j1"], "j2": js["j2"], "j3": js["j3"],
@@ -120,11 +113,10 @@ def main():
     ap.add_argument("--paths", default="")
     ap.add_argument("--render-only", action="store_true")
     args = ap.parse_args()
+    data = None
     if not args.render_only:
         paths = [tuple(p.split("/")) for p in args.paths.split(",")] if args.paths else PATHS
-        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
-                                cwd=ROOT).stdout.strip()
-        data = {"date": datetime.date.today().isoformat(), "machine": machine(), "commit": commit, "paths": []}
+        data = study_data()
         with tempfile.TemporaryDirectory() as folder:
             params = {}
             for shape in SHAPES:
@@ -138,11 +130,7 @@ def main():
                     f"{s} {pct(row[s]['mean_share'])} % in {row[s]['safety_ms']:.0f} ms" for s in SHAPES),
                     file=sys.stderr)
                 data["paths"].append(row)
-        DATA.parent.mkdir(parents=True, exist_ok=True)
-        DATA.write_text(json.dumps(data, indent=1) + "\n")
-    text = render(json.loads(DATA.read_text()))
-    DATA.with_suffix(".md").write_text(text)
-    print(text, end="")
+    write_study(DATA, data, render)
 
 
 if __name__ == "__main__":

@@ -139,7 +139,9 @@ class WaypointGrowth {
   }
 
  private:
-  // The probe (Certifier::segment_probe) of every segment at this waypoint with the extent set.
+  // The probe (Certifier::segment_probe) of every segment at this waypoint with the extent set. Only
+  // the pairs joint i moves: a configuration the step adds is one of the certified region with joint
+  // i moved (the other pairs' geometry does not change), so they are apart there as well.
   bool probe(int i, int side, double extent) {
     double& bound = side ? b_[k_].upper[i] : b_[k_].lower[i];
     const double kept = bound;  // restored exactly: q -+ (q -+ bound) may differ from it in the last bit
@@ -147,7 +149,7 @@ class WaypointGrowth {
     bool free = true;
     for (const auto& [p, r] : segments_) {
       free = certifier_.segment_probe(ctx_, b_[p].lower, b_[p].upper, b_[r].lower, b_[r].upper, b_[p].q,
-                                      b_[r].q, kProbeSamples, stats_, nullptr, leaf_limit_);
+                                      b_[r].q, kProbeSamples, stats_, nullptr, leaf_limit_, i);
       if (!free) break;
     }
     bound = kept;

@@ -45,6 +45,42 @@ TEST_F(RoomTest, TheFreeRangeEndsAtTheWallAndAtTheLimit) {
   EXPECT_DOUBLE_EQ(free[0].lower, -3.0);
 }
 
+// A needle 1 m long and 2 mm wide (link2, turned by j2 about z) and a post 2 mm square standing
+// 0.8 m from the axis on the robot's base: a self pair (link1 lies between them). Turning from 0
+// toward +y, the needle's leading face (at 1 mm from its axis) meets the post's corner
+// (0.001, 0.799) when 0.799 cos(t) - 0.001 sin(t) = 0.001: t = acos(0.001 / R) - atan(0.001 / 0.799),
+// R = sqrt(0.799^2 + 0.001^2), 1.56830 rad; it has passed the post 5 mrad later. A sweep in fixed
+// steps of 0.02 rad (samples at 1.56 and 1.58) steps over it.
+TEST(RoomSelfTest, TheFreeRangeEndsAtAThinPartOfTheRobotItself) {
+  test::TempDir dir;
+  const Scene scene = Scene::load(dir.write("needle.xml", R"(<mujoco model="needle">
+  <compiler angle="radian" autolimits="true"/>
+  <worldbody>
+    <body name="base">
+      <geom name="post" type="box" size="0.001 0.001 0.3" pos="0 0.8 0.3"/>
+      <body name="link1" pos="0 0 0.3">
+        <joint name="j1" type="hinge" axis="1 0 0" range="-0.1 0.1"/>
+        <inertial pos="0 0 0" mass="1" diaginertia="0.01 0.01 0.01"/>
+        <body name="link2">
+          <joint name="j2" type="hinge" axis="0 0 1" range="-3 3"/>
+          <geom name="needle" type="box" size="0.5 0.001 0.01" pos="0.5 0 0"/>
+          <site name="tool0" pos="1 0 0"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+)"));
+  ASSERT_EQ(scene.self_pairs().size(), 1u);
+  const double r = std::hypot(0.799, 0.001);
+  const double touch = std::acos(0.001 / r) - std::atan(0.001 / 0.799);
+  RobotState state(scene);
+  const auto free = one_joint_free_ranges(state, Eigen::VectorXd::Zero(2), 1e-5);
+  EXPECT_NEAR(free[1].upper, touch, 2e-5);
+  EXPECT_LE(free[1].upper, touch);
+  EXPECT_DOUBLE_EQ(free[1].lower, -3.0);  // turned the other way, the needle's far side misses the post
+}
+
 TEST_F(RoomTest, ANominalInsideTheWallHasNoFreeRangeAndNoShare) {
   // At 1.5 rad the link passes through the wall.
   const RoomReport r = measure_room(*scene_, {box(1.5, 1.5, 1.5)});

@@ -15,8 +15,9 @@
 namespace leeway {
 namespace {
 
-// The largest step of the free-range sweep [rad for hinges, m for slides]: conservative
-// advancement covers the obstacles, this bounds how far a self pair can move between checks.
+// The largest step of the free-range sweep where conservative advancement does not bound it [rad
+// for hinges, m for slides]: beside a plane obstacle (which has no box to measure) or a self pair
+// whose boxes overlap (their geoms may still be apart), the sweep samples at this step.
 constexpr double kMaxHingeStep = 0.02;
 constexpr double kMaxSlideStep = 0.005;
 // The corners of every box are enumerated up to this many joints (2^10 = 1024 configurations).
@@ -29,10 +30,14 @@ bool moves_with(const mjModel& m, int body, int joint_body) {
   return false;
 }
 
-// Joint i's sweep at configuration q: the link geoms it moves and the largest distance of a point
-// of their boxes from its axis (a hinge moves such a point by at most that lever times the angle).
+// Joint i's sweep at configuration q: the link geoms it moves, the self pairs it moves one geom of
+// (that geom first), and the largest distance of a point of the moved geoms' boxes from its axis (a
+// hinge moves such a point by at most that lever times the angle, and the distance from its own
+// axis does not change as it turns).
 struct Sweep {
   std::vector<int> geoms;
+  std::vector<std::pair<int, int>> self;
+  bool planes = false;  // an obstacle is a plane: no box bounds the step toward it
   double lever = 0.0;
 };
 
@@ -43,9 +48,7 @@ Sweep sweep_of(const Scene& scene, const mjData& d, int i) {
   const Eigen::Vector3d anchor = vec3(d.xanchor + 3 * joint.id);
   const Eigen::Vector3d axis = vec3(d.xaxis + 3 * joint.id).normalized();
   Sweep s;
-  for (int g : scene.link_geoms()) {
-    if (!moves_with(m, m.geom_bodyid[g], joint_body)) continue;
-    s.geoms.push_back(g);
+  auto reach = [&](int g) {
     const Box b = geom_box(m, d, g);
     for (int c = 0; c < 8; ++c) {
       Eigen::Vector3d corner = b.half_size;
@@ -54,19 +57,42 @@ Sweep sweep_of(const Scene& scene, const mjData& d, int i) {
       const Eigen::Vector3d r = b.center + b.rotation * corner - anchor;
       s.lever = std::max(s.lever, (r - r.dot(axis) * axis).norm());
     }
+  };
+  for (int g : scene.link_geoms()) {
+    if (!moves_with(m, m.geom_bodyid[g], joint_body)) continue;
+    s.geoms.push_back(g);
+    reach(g);
   }
+  for (const RobotPair& p : scene.self_pairs()) {
+    const bool first = moves_with(m, m.geom_bodyid[p.geom1], joint_body);
+    if (first == moves_with(m, m.geom_bodyid[p.geom2], joint_body)) continue;
+    s.self.emplace_back(first ? p.geom1 : p.geom2, first ? p.geom2 : p.geom1);
+    reach(s.self.back().first);
+  }
+  for (int o : scene.obstacle_geoms()) s.planes = s.planes || !has_bounding_box(m, o);
   return s;
 }
 
-// The smallest distance from the geoms of `sweep` to the obstacles with a bounding box (a lower
-// bound of the true clearance; half-spaces cannot be stepped over and are left to the checks).
-double sweep_clearance(const Scene& scene, const mjData& d, const Sweep& sweep) {
+// The box distance of two geoms less their contact margin (a lower bound of how far they are from
+// touching).
+double gap(const mjModel& m, const mjData& d, int g1, int g2) {
+  return box_distance(geom_box(m, d, g1), geom_box(m, d, g2)) -
+         std::max(m.geom_margin[g1], m.geom_margin[g2]);
+}
+
+// How far the geoms of `sweep` may move before one can touch an obstacle or its self-pair partner:
+// the smallest gap, a lower bound of the true clearance. A self pair whose boxes overlap, or a plane
+// obstacle, caps it at `sampled` (the sweep then samples, as it must for them).
+double sweep_clearance(const Scene& scene, const mjData& d, const Sweep& sweep, double sampled) {
   const mjModel& m = scene.model();
-  double best = INFINITY;
+  double best = sweep.planes ? sampled : INFINITY;
   for (int o : scene.obstacle_geoms()) {
     if (!has_bounding_box(m, o)) continue;
-    const Box ob = geom_box(m, d, o);
-    for (int g : sweep.geoms) best = std::min(best, box_distance(geom_box(m, d, g), ob));
+    for (int g : sweep.geoms) best = std::min(best, gap(m, d, g, o));
+  }
+  for (const auto& [moved, other] : sweep.self) {
+    const double g = gap(m, d, moved, other);
+    best = std::min(best, g > 0 ? g : sampled);
   }
   return best;
 }
@@ -76,15 +102,14 @@ double sweep_side(RobotState& state, const Sweep& sweep, Eigen::VectorXd q, int 
                   double tolerance) {
   const Scene& scene = state.scene();
   const bool slide = scene.joints()[static_cast<size_t>(i)].prismatic;
-  const double max_step = slide ? kMaxSlideStep : kMaxHingeStep;
+  // A slide moves every point of its geoms by the step itself (lever 1).
+  const double lever = slide ? 1.0 : std::max(sweep.lever, 1e-9);
+  const double sampled = (slide ? kMaxSlideStep : kMaxHingeStep) * lever;
   const double start = q[i];
   double free = start;
   while (sign * (limit - free) > 0) {
     state.set(q);
-    // A slide moves every point of its geoms by the step itself (lever 1).
-    const double lever = slide ? 1.0 : std::max(sweep.lever, 1e-9);
-    const double advance =
-        std::clamp(sweep_clearance(scene, state.data(), sweep) / lever, tolerance, max_step);
+    const double advance = std::max(sweep_clearance(scene, state.data(), sweep, sampled) / lever, tolerance);
     const double next = sign > 0 ? std::min(limit, free + advance) : std::max(limit, free - advance);
     q[i] = next;
     if (!state.in_collision(q)) {

@@ -513,8 +513,9 @@ GrowReport grow_bounds(const Scene& scene, std::vector<WaypointBounds>& bounds,
   detail::parallel_for(static_cast<int>(count), threads, [&] {
     auto state = std::make_shared<RobotState>(scene);
     return [&, state](int k) {
-      targets[static_cast<size_t>(k)] =
-          waypoint_targets(*state, bounds[static_cast<size_t>(k)].q, caps, lever);
+      if (grows[static_cast<size_t>(k)])
+        targets[static_cast<size_t>(k)] =
+            waypoint_targets(*state, bounds[static_cast<size_t>(k)].q, caps, lever);
     };
   });
   // blocked[k][2 i + side]: that side stopped short in an earlier round.

@@ -15,11 +15,15 @@
 namespace leeway {
 namespace {
 
-// The largest step of the free-range sweep where conservative advancement does not bound it [rad
-// for hinges, m for slides]: beside a plane obstacle (which has no box to measure) or a self pair
-// whose boxes overlap (their geoms may still be apart), the sweep samples at this step.
+// The largest step of the free-range sweep where conservative advancement gives none [rad for
+// hinges, m for slides]: beside a plane obstacle (which has no box to measure) or a self pair whose
+// boxes overlap (their geoms may still be apart), the sweep samples at this step.
 constexpr double kMaxHingeStep = 0.02;
 constexpr double kMaxSlideStep = 0.005;
+// Beside a self pair whose boxes are apart, a step is at least this share of that step: robot parts
+// that pass each other closely without touching (the links of a long chain) would make the sweep
+// crawl; such a pair is sampled eight times as densely as where boxes overlap.
+constexpr double kSelfFloor = 1.0 / 8;
 // The corners of every box are enumerated up to this many joints (2^10 = 1024 configurations).
 constexpr int kMaxCornerJoints = 10;
 
@@ -30,15 +34,29 @@ bool moves_with(const mjModel& m, int body, int joint_body) {
   return false;
 }
 
-// Joint i's sweep at configuration q: the link geoms it moves, the self pairs it moves one geom of
-// (that geom first), and the largest distance of a point of the moved geoms' boxes from its axis (a
-// hinge moves such a point by at most that lever times the angle, and the distance from its own
-// axis does not change as it turns).
+// A geom joint i moves, and its lever: the largest distance of a point of its box from the joint's
+// axis (a hinge moves such a point by at most that times the angle, and the distance does not change
+// as it turns); 1 for a slide, which moves every point by the step itself.
+struct Moved {
+  int geom = -1;
+  double lever = 1.0;
+  bool link = false;  // a link geom: checked against the obstacles
+  Box box;            // at the sweep's current configuration
+};
+
+// A geom the joint does not move (an obstacle, or the other geom of a self pair): its box stays.
+struct Fixed {
+  Box box;
+  double margin = 0.0;
+};
+
+// Joint i's sweep at configuration q: the geoms it moves, the obstacles with a box, and the self
+// pairs it moves one geom of (the index of that geom in `moved`, and the other one).
 struct Sweep {
-  std::vector<int> geoms;
-  std::vector<std::pair<int, int>> self;
+  std::vector<Moved> moved;
+  std::vector<Fixed> obstacles;
+  std::vector<std::pair<size_t, Fixed>> self;
   bool planes = false;  // an obstacle is a plane: no box bounds the step toward it
-  double lever = 0.0;
 };
 
 Sweep sweep_of(const Scene& scene, const mjData& d, int i) {
@@ -48,68 +66,86 @@ Sweep sweep_of(const Scene& scene, const mjData& d, int i) {
   const Eigen::Vector3d anchor = vec3(d.xanchor + 3 * joint.id);
   const Eigen::Vector3d axis = vec3(d.xaxis + 3 * joint.id).normalized();
   Sweep s;
-  auto reach = [&](int g) {
-    const Box b = geom_box(m, d, g);
-    for (int c = 0; c < 8; ++c) {
-      Eigen::Vector3d corner = b.half_size;
-      for (int k = 0; k < 3; ++k)
-        if (c & (1 << k)) corner[k] = -corner[k];
-      const Eigen::Vector3d r = b.center + b.rotation * corner - anchor;
-      s.lever = std::max(s.lever, (r - r.dot(axis) * axis).norm());
+  std::vector<int> index(static_cast<size_t>(m.ngeom), -1);
+  auto moved = [&](int g) {
+    if (index[static_cast<size_t>(g)] >= 0) return static_cast<size_t>(index[static_cast<size_t>(g)]);
+    Moved out{g, 1.0, false, geom_box(m, d, g)};
+    if (!joint.prismatic) {
+      out.lever = 1e-9;
+      for (int c = 0; c < 8; ++c) {
+        Eigen::Vector3d corner = out.box.half_size;
+        for (int k = 0; k < 3; ++k)
+          if (c & (1 << k)) corner[k] = -corner[k];
+        const Eigen::Vector3d r = out.box.center + out.box.rotation * corner - anchor;
+        out.lever = std::max(out.lever, (r - r.dot(axis) * axis).norm());
+      }
     }
+    index[static_cast<size_t>(g)] = static_cast<int>(s.moved.size());
+    s.moved.push_back(out);
+    return s.moved.size() - 1;
   };
-  for (int g : scene.link_geoms()) {
-    if (!moves_with(m, m.geom_bodyid[g], joint_body)) continue;
-    s.geoms.push_back(g);
-    reach(g);
-  }
+  for (int g : scene.link_geoms())
+    if (moves_with(m, m.geom_bodyid[g], joint_body)) s.moved[moved(g)].link = true;
   for (const RobotPair& p : scene.self_pairs()) {
     const bool first = moves_with(m, m.geom_bodyid[p.geom1], joint_body);
     if (first == moves_with(m, m.geom_bodyid[p.geom2], joint_body)) continue;
-    s.self.emplace_back(first ? p.geom1 : p.geom2, first ? p.geom2 : p.geom1);
-    reach(s.self.back().first);
+    const int other = first ? p.geom2 : p.geom1;
+    s.self.emplace_back(moved(first ? p.geom1 : p.geom2), Fixed{geom_box(m, d, other), m.geom_margin[other]});
   }
-  for (int o : scene.obstacle_geoms()) s.planes = s.planes || !has_bounding_box(m, o);
+  for (int o : scene.obstacle_geoms()) {
+    if (has_bounding_box(m, o))
+      s.obstacles.push_back(Fixed{geom_box(m, d, o), m.geom_margin[o]});
+    else
+      s.planes = true;
+  }
   return s;
 }
 
-// The box distance of two geoms less their contact margin (a lower bound of how far they are from
-// touching).
-double gap(const mjModel& m, const mjData& d, int g1, int g2) {
-  return box_distance(geom_box(m, d, g1), geom_box(m, d, g2)) -
-         std::max(m.geom_margin[g1], m.geom_margin[g2]);
+// A lower bound of how far a moved geom is from touching a fixed one: their boxes' distance less the
+// contact margin. `limit`: a bound the caller needs only when it is smaller (the boxes' bounding
+// spheres answer the rest without the exact distance).
+double gap(const Moved& g, const Fixed& f, double margin, double limit) {
+  const double spheres =
+      (g.box.center - f.box.center).norm() - g.box.half_size.norm() - f.box.half_size.norm() - margin;
+  if (spheres >= limit) return spheres;
+  return box_distance(g.box, f.box) - margin;
 }
 
-// How far the geoms of `sweep` may move before one can touch an obstacle or its self-pair partner:
-// the smallest gap, a lower bound of the true clearance. A self pair whose boxes overlap, or a plane
-// obstacle, caps it at `sampled` (the sweep then samples, as it must for them).
-double sweep_clearance(const Scene& scene, const mjData& d, const Sweep& sweep, double sampled) {
-  const mjModel& m = scene.model();
-  double best = sweep.planes ? sampled : INFINITY;
-  for (int o : scene.obstacle_geoms()) {
-    if (!has_bounding_box(m, o)) continue;
-    for (int g : sweep.geoms) best = std::min(best, gap(m, d, g, o));
+// How far the joint may move [rad or m] before a geom of `sweep` can touch an obstacle or its
+// self-pair partner: per pair, its gap (a lower bound of the true clearance) over the moved geom's
+// lever. A self pair whose boxes overlap, or a plane obstacle, caps it at `sampled`; a self pair
+// whose boxes are apart allows at least kSelfFloor of it. The moved geoms' boxes are updated to the
+// configuration of `d` first.
+double sweep_step(const mjModel& m, const mjData& d, Sweep& sweep, double sampled) {
+  for (Moved& g : sweep.moved) g.box = geom_box(m, d, g.geom);
+  double step = sweep.planes ? sampled : INFINITY;
+  for (const Fixed& o : sweep.obstacles)
+    for (const Moved& g : sweep.moved) {
+      if (!g.link) continue;
+      const double margin = std::max(m.geom_margin[g.geom], o.margin);
+      step = std::min(step, gap(g, o, margin, step * g.lever) / g.lever);
+    }
+  for (const auto& [k, other] : sweep.self) {
+    const Moved& g = sweep.moved[k];
+    const double margin = std::max(m.geom_margin[g.geom], other.margin);
+    // Below the floor a pair with its boxes apart no longer lowers the step: its exact gap matters
+    // only down to there.
+    const double apart = gap(g, other, margin, std::max(step, kSelfFloor * sampled) * g.lever);
+    step = std::min(step, apart > 0 ? std::max(apart / g.lever, kSelfFloor * sampled) : sampled);
   }
-  for (const auto& [moved, other] : sweep.self) {
-    const double g = gap(m, d, moved, other);
-    best = std::min(best, g > 0 ? g : sampled);
-  }
-  return best;
+  return step;
 }
 
 // How far joint i moves from q[i] in direction `sign` before the robot collides, within `limit`.
-double sweep_side(RobotState& state, const Sweep& sweep, Eigen::VectorXd q, int i, double sign, double limit,
+double sweep_side(RobotState& state, Sweep& sweep, Eigen::VectorXd q, int i, double sign, double limit,
                   double tolerance) {
   const Scene& scene = state.scene();
-  const bool slide = scene.joints()[static_cast<size_t>(i)].prismatic;
-  // A slide moves every point of its geoms by the step itself (lever 1).
-  const double lever = slide ? 1.0 : std::max(sweep.lever, 1e-9);
-  const double sampled = (slide ? kMaxSlideStep : kMaxHingeStep) * lever;
+  const double sampled = scene.joints()[static_cast<size_t>(i)].prismatic ? kMaxSlideStep : kMaxHingeStep;
   const double start = q[i];
   double free = start;
   while (sign * (limit - free) > 0) {
     state.set(q);
-    const double advance = std::max(sweep_clearance(scene, state.data(), sweep, sampled) / lever, tolerance);
+    const double advance = std::max(sweep_step(scene.model(), state.data(), sweep, sampled), tolerance);
     const double next = sign > 0 ? std::min(limit, free + advance) : std::max(limit, free - advance);
     q[i] = next;
     if (!state.in_collision(q)) {
@@ -141,7 +177,7 @@ std::vector<FreeRange> one_joint_free_ranges(RobotState& state, const Eigen::Vec
     r.lower = r.upper = q[i];
     if (blocked) continue;
     state.set(q);
-    const Sweep sweep = sweep_of(scene, state.data(), i);
+    Sweep sweep = sweep_of(scene, state.data(), i);
     const RobotJoint& joint = scene.joints()[static_cast<size_t>(i)];
     r.lower = sweep_side(state, sweep, q, i, -1.0, joint.lower, tolerance);
     r.upper = sweep_side(state, sweep, q, i, +1.0, joint.upper, tolerance);

@@ -38,9 +38,6 @@ Eigen::Vector3d closest_point(const Box& box, const Eigen::Vector3d& p) {
   return box.center + box.rotation * clamped;
 }
 
-namespace {
-
-// The 8 corners of a box, corner k having coordinate i at +half_size[i] when bit i of k is set.
 std::array<Eigen::Vector3d, 8> box_corners(const Box& b) {
   std::array<Eigen::Vector3d, 8> c;
   for (int k = 0; k < 8; ++k) {
@@ -50,6 +47,8 @@ std::array<Eigen::Vector3d, 8> box_corners(const Box& b) {
   }
   return c;
 }
+
+namespace {
 
 // Closest points of segments [p1, q1] and [p2, q2] (Ericson, Real-Time Collision Detection, 5.1.9),
 // parallel and degenerate segments included.

@@ -71,16 +71,6 @@ double chain_lever(const Scene& scene, const std::vector<int>& bodies, const std
   return lever + offset;
 }
 
-// The eight corners of a box.
-std::array<Eigen::Vector3d, 8> corners_of(const Box& b) {
-  std::array<Eigen::Vector3d, 8> out;
-  for (int i = 0; i < 8; ++i) {
-    const Eigen::Vector3d sign((i & 1) ? 1.0 : -1.0, (i & 2) ? 1.0 : -1.0, (i & 4) ? 1.0 : -1.0);
-    out[static_cast<size_t>(i)] = b.center + b.rotation * sign.cwiseProduct(b.half_size);
-  }
-  return out;
-}
-
 // Whether the sphere that holds the swept link without the Jacobian (SweptLink::cheap_radius) and
 // the obstacle's bounding sphere are more than `margin` apart (never for a plane).
 bool apart_by_spheres(const SweptLink& sweep, const SweepObstacle& obs, double margin) {
@@ -174,7 +164,7 @@ void Certifier::add_pivots(const RobotState& state, const LinkChain& link, const
   const mjModel& m = scene_->model();
   const mjData& d = state.data();
   const size_t n = jids.size();
-  const std::array<Eigen::Vector3d, 8> corners = corners_of(geom_box(m, d, link.geom));
+  const std::array<Eigen::Vector3d, 8> corners = box_corners(geom_box(m, d, link.geom));
   auto frame_of = [&](int body) { return mat3(d.xmat + 9 * body); };
   // A hinge that is its body's only joint: the body's frame turns about it and nothing else.
   auto pivot_hinge = [&](size_t k) {

@@ -72,11 +72,8 @@ Sweep sweep_of(const Scene& scene, const mjData& d, int i) {
     Moved out{g, 1.0, false, geom_box(m, d, g)};
     if (!joint.prismatic) {
       out.lever = 1e-9;
-      for (int c = 0; c < 8; ++c) {
-        Eigen::Vector3d corner = out.box.half_size;
-        for (int k = 0; k < 3; ++k)
-          if (c & (1 << k)) corner[k] = -corner[k];
-        const Eigen::Vector3d r = out.box.center + out.box.rotation * corner - anchor;
+      for (const Eigen::Vector3d& corner : box_corners(out.box)) {
+        const Eigen::Vector3d r = corner - anchor;
         out.lever = std::max(out.lever, (r - r.dot(axis) * axis).norm());
       }
     }

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <array>
 
 namespace leeway {
 
@@ -56,6 +57,9 @@ Box geom_box(const mjModel& m, const mjData& d, int geom);
 //! the clearance all skip them; check_scene reports a collidable plane as a problem instead (a
 //! floor must have contype="0" conaffinity="0", docs/mjcf-conventions.md).
 bool has_bounding_box(const mjModel& m, int geom);
+
+//! The 8 corners of a box [m], corner k having coordinate i at +half_size[i] when bit i of k is set.
+std::array<Eigen::Vector3d, 8> box_corners(const Box& b);
 
 //! The world-aligned box around an oriented box [m].
 Eigen::AlignedBox3d aligned(const Box& b);

@@ -29,10 +29,12 @@ struct RoomOptions {
 //! The one-joint free range of joint i at configuration q: the largest interval [lower, upper]
 //! around q[i], within the joint's limits, over which moving joint i alone (the others at q) keeps
 //! the robot free of the obstacles and of itself (RobotState::in_collision). Found by conservative
-//! advancement: each step turns joint i by the clearance to the obstacles over the largest
-//! distance of a geom it moves from its axis (so no obstacle is stepped over), at most 0.02 rad
-//! (slides: 5 mm) so that self pairs are checked densely, then bisection to `tolerance` once a
-//! step collides. {q[i], q[i]} when q itself collides.
+//! advancement: each step turns joint i by no more than any geom it moves may turn before it can
+//! touch an obstacle or the other geom of a self pair (their boxes' gap over that geom's largest
+//! distance from the axis), then bisection to `tolerance` once a step collides. Where no such bound
+//! exists (a plane obstacle, a self pair whose boxes overlap) the step is at most 0.02 rad (slides:
+//! 5 mm); beside a self pair whose boxes are apart it is at least an eighth of that (the sweep is
+//! a measure, not a proof: the certificate proves the bounds). {q[i], q[i]} when q itself collides.
 struct FreeRange {
   double lower = 0.0, upper = 0.0;  //!< [rad or m]
 };

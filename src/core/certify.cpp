@@ -655,7 +655,8 @@ bool Certifier::segment_free(CertifyContext& ctx, const Eigen::VectorXd& lower_a
     }
     // Joint splits within a share of the remaining budget; when they do not suffice, a shorter
     // stretch of the path may.
-    const bool worth_splitting = (motion.array() > 0.05 * half.array() + 1e-4).any();
+    const bool worth_splitting =
+        budget.split_path_on_failure && (motion.array() > 0.05 * half.array() + 1e-4).any();
     const long share = splittable && worth_splitting ? std::max(64L, remaining / 16) : remaining;
     CertifyFailure local;
     if (region_free_impl(ctx, lo, hi, stats, &local, std::min(share, remaining), budget.leaf_limit, pairs)) {

@@ -162,7 +162,9 @@ class WaypointGrowth {
   // proof there (Certifier::segment_free's grown_joint). The old bounds are taken as they are, to
   // the last bit, and the new one is what set() writes.
   bool slab_free(int i, int side, double to, long leaves) {
-    const CertifyBudget slab{std::max(64L, leaves), leaf_limit_};
+    // A stretch that fails is not cut into shorter ones: growth's slabs go further for the same
+    // leaves when each stretch's joint splits get the whole budget (docs/algorithm.md, step 4).
+    const CertifyBudget slab{std::max(64L, leaves), leaf_limit_, false};
     bool free = true;
     for (const auto& [p, r] : segments_) {
       Eigen::VectorXd lo[2] = {b_[p].lower, b_[r].lower}, hi[2] = {b_[p].upper, b_[r].upper};

@@ -38,6 +38,11 @@ struct CertifyBudget {
   //! The caller's work limit across calls: no call lets the CertifyStats it is given count more than
   //! this many leaves (probe checks included); a call that reaches it fails with `budget` set.
   long leaf_limit = std::numeric_limits<long>::max();
+  //! Certifier::segment_free: when a stretch of the segment cannot be proven on a share of the
+  //! budget, whether shorter stretches are tried (true) or the stretch gets the whole remaining
+  //! budget for its joint splits (false: each shorter stretch proves the whole box of the other
+  //! joints there again, which costs a thin growth slab more than it saves).
+  bool split_path_on_failure = true;
 };
 
 //! Counters of certification work.

@@ -654,7 +654,7 @@ bool Certifier::segment_free(CertifyContext& ctx, const Eigen::VectorXd& lower_a
       return false;
     }
     // Joint splits within a share of the remaining budget; when they do not suffice, a shorter
-    // stretch of the path may.
+    // stretch of the path may (unless the budget says not to cut: then the whole remaining budget).
     const bool worth_splitting =
         budget.split_path_on_failure && (motion.array() > 0.05 * half.array() + 1e-4).any();
     const long share = splittable && worth_splitting ? std::max(64L, remaining / 16) : remaining;

@@ -1111,7 +1111,7 @@ TEST_F(CertifyTest, SlabIsNotCutWhereItThins) {
   EXPECT_EQ(scene.geom_label(failure.obstacle_geom), "plate");
 }
 
-// Two slides carry a 2 cm cube in the plane z = 0.5 (x, then y); a block fills x >= 1.15, y >= 1.0.
+// The cross slides of test_util.hpp (a 2 cm cube at z = 0.5); a block fills x >= 1.15, y >= 1.0.
 // The segment goes from x in [0, 1], y in [0.5, 1] to x in [0.2, 1.2], y in [0.4, 0.9]: the centres
 // move 0.2 and 0.1 m, less than half the half-widths (0.5 and 0.25 m), so the path is not cut for
 // its motion. By hand: at t the cube reaches x = 1.01 + 0.2 t and y = 1.01 - 0.1 t, inside the block
@@ -1119,22 +1119,8 @@ TEST_F(CertifyTest, SlabIsNotCutWhereItThins) {
 // (1.21, 1.01), inside the block; the halves' hulls reach x = 1.11 (t <= 0.5, 4 cm short of the
 // block) and y = 0.96 (t >= 0.5, 4 cm short). Cut where a stretch fails, the segment is certified;
 // told not to cut (CertifyBudget::split_path_on_failure, growth's slabs), it is not.
-const char* kCrossSlideCell = R"(<mujoco model="cross_slide">
-  <compiler angle="radian" autolimits="true"/>
-  <worldbody>
-    <body name="carriage" pos="0 0 0.5">
-      <joint name="x" type="slide" axis="1 0 0" range="-1 2"/>
-      <inertial pos="0 0 0" mass="1" diaginertia="0.1 0.1 0.1"/>
-      <body name="cube">
-        <joint name="y" type="slide" axis="0 1 0" range="-1 2"/>
-        <geom name="cube_box" type="box" size="0.01 0.01 0.01"/>
-        <site name="tool0"/>
-      </body>
-    </body>
-    <geom name="block" type="box" size="0.425 0.5 0.3" pos="1.575 1.5 0.5"/>
-  </worldbody>
-</mujoco>
-)";
+const std::string kCrossSlideCell =
+    test::cross_slide_cell(R"(<geom name="block" type="box" size="0.425 0.5 0.3" pos="1.575 1.5 0.5"/>)");
 
 TEST_F(CertifyTest, AStretchWhoseHullIsNotFreeIsCutUnlessTheBudgetSaysNot) {
   test::TempDir dir;

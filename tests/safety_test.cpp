@@ -9,7 +9,9 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "leeway/core/certify.hpp"
 #include "leeway/core/confidence.hpp"
+#include "leeway/core/kinematics.hpp"
 #include "leeway/core/safety.hpp"
 #include "test_util.hpp"
 
@@ -207,6 +209,84 @@ TEST_F(OneLinkSafetyTest, TheBoundsFileSaysWhichSegmentsRunBoxesProved) {
 // and b (bent).
 std::string chain_cell(int n) {
   return test::serial_chain_cell(n, "-3 3", "0.9 0 1", [](int i) { return i % 2 ? "0.02" : "0"; });
+}
+
+// Two waypoints of the cross slides (test_util.hpp): x in [xa, xa + 1], y in [ya, ya + 0.5] at the
+// first, x and y moved by dx and dy at the second, the guide as given; growth off.
+std::vector<WaypointBounds> cross_slide_segment(double xa, double ya, double dx, double dy) {
+  std::vector<WaypointBounds> bounds(2);
+  for (int k = 0; k < 2; ++k) {
+    WaypointBounds& w = bounds[static_cast<size_t>(k)];
+    w.lower = Eigen::Vector2d(xa + k * dx, ya + k * dy);
+    w.upper = w.lower + Eigen::Vector2d(1.0, 0.5);
+    w.q = (w.lower + w.upper) / 2;
+    w.guide_lower = w.lower;
+    w.guide_upper = w.upper;
+    w.collapsed.assign(2, false);
+  }
+  return bounds;
+}
+
+// A long segment (the centres move 0.2 and -0.1 m, more than a twentieth of the half-widths 0.5
+// and 0.25 m plus 5 mm) beside the block x >= 1.15, y >= 1.0: the region is free but its hull
+// over the whole path is not (worked in CertifyTest.AStretchWhoseHullIsNotFreeIsCutUnlessTheBudgetSaysNot).
+// The certified mode does not cut a long segment where its proof fails: the first certificate
+// fails, the stage shrinks, and what it keeps is proven and inside the guide, narrower somewhere.
+TEST(SafetyPathCutTest, ALongSegmentIsNotCutWhereItsProofFailsAndShrinksInstead) {
+  test::TempDir dir;
+  const Scene scene = Scene::load(dir.write(
+      "cross.xml",
+      test::cross_slide_cell(R"(<geom name="block" type="box" size="0.425 0.5 0.3" pos="1.575 1.5 0.5"/>)")));
+  std::vector<WaypointBounds> bounds = cross_slide_segment(0.0, 0.5, 0.2, -0.1);
+  const std::vector<WaypointBounds> guide = bounds;
+  SafetyParams params;
+  params.grow = "none";
+  const SafetyReport r = make_safe(scene, bounds, params);
+  ASSERT_EQ(r.segments.size(), 1u);
+  EXPECT_TRUE(r.segments[0].passed);
+  EXPECT_GE(r.segments[0].shrink_steps, 1);
+  bool narrower = false;
+  for (size_t k = 0; k < 2; ++k) {
+    EXPECT_TRUE((bounds[k].lower.array() >= guide[k].lower.array()).all());
+    EXPECT_TRUE((bounds[k].upper.array() <= guide[k].upper.array()).all());
+    narrower = narrower || (bounds[k].upper.array() < guide[k].upper.array()).any() ||
+               (bounds[k].lower.array() > guide[k].lower.array()).any();
+  }
+  EXPECT_TRUE(narrower);
+  Certifier certifier(scene);
+  CertifyContext ctx(scene);
+  CertifyStats stats;
+  EXPECT_TRUE(
+      certifier.segment_free(ctx, bounds[0].lower, bounds[0].upper, bounds[1].lower, bounds[1].upper, stats));
+}
+
+// A short segment (the centres move 0.02 and -0.015 m, within 0.05 x 0.5 + 0.005 = 0.03 and
+// 0.05 x 0.25 + 0.005 = 0.0175 m) beside the block x >= 1.0225, y >= 1.004. By hand, the cube's far
+// corner is at x = 1.01 + 0.02 t, y = 1.01 - 0.015 t; it comes within the 1 mm margin of the block
+// only where x >= 1.0215 (t >= 0.575) and y >= 1.003 (t <= 0.467) at once: never, the region is
+// free. The hull over [0, 1] reaches (1.03, 1.01), inside the block; the first half's stops at
+// x = 1.02 (2.5 mm from the block) and the second half's at y = 1.0025 (1.5 mm). Cut in two, the
+// segment is certified at once, with no shrink step, and keeps the guide exactly.
+TEST(SafetyPathCutTest, AShortSegmentIsCutWhereItsProofFailsAndKeepsTheGuide) {
+  test::TempDir dir;
+  const Scene scene = Scene::load(
+      dir.write("cross.xml",
+                test::cross_slide_cell(
+                    R"(<geom name="block" type="box" size="0.48875 0.498 0.3" pos="1.51125 1.502 0.5"/>)")));
+  std::vector<WaypointBounds> bounds = cross_slide_segment(0.0, 0.5, 0.02, -0.015);
+  const std::vector<WaypointBounds> guide = bounds;
+  RobotState state(scene);
+  EXPECT_TRUE(state.in_collision(Eigen::Vector2d(1.02, 1.0)));  // the hull's corner (1.03, 1.01)
+  SafetyParams params;
+  params.grow = "none";
+  const SafetyReport r = make_safe(scene, bounds, params);
+  ASSERT_EQ(r.segments.size(), 1u);
+  EXPECT_TRUE(r.segments[0].passed);
+  EXPECT_EQ(r.segments[0].shrink_steps, 0);
+  for (size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(bounds[k].lower, guide[k].lower);
+    EXPECT_EQ(bounds[k].upper, guide[k].upper);
+  }
 }
 
 TEST(SafetyBudgetTest, ALongChainStopsAtTheSegmentBudgetAndIsNotCertified) {

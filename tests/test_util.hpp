@@ -204,6 +204,29 @@ inline std::string one_link_cell(const std::string& world, const std::string& ke
 )";
 }
 
+//! Cross slides: joint x (slide along x, body 'carriage' at z = 0.5), then joint y (slide along y)
+//! carry a 2 cm cube (cube_box, half-size 0.01, tool0 at its centre); both ranges [-1, 2] m.
+//! `world` is inserted into the world body.
+inline std::string cross_slide_cell(const std::string& world) {
+  return R"(<mujoco model="cross_slide">
+  <compiler angle="radian" autolimits="true"/>
+  <worldbody>
+    <body name="carriage" pos="0 0 0.5">
+      <joint name="x" type="slide" axis="1 0 0" range="-1 2"/>
+      <inertial pos="0 0 0" mass="1" diaginertia="0.1 0.1 0.1"/>
+      <body name="cube">
+        <joint name="y" type="slide" axis="0 1 0" range="-1 2"/>
+        <geom name="cube_box" type="box" size="0.01 0.01 0.01"/>
+        <site name="tool0"/>
+      </body>
+    </body>
+    )" + world +
+         R"(
+  </worldbody>
+</mujoco>
+)";
+}
+
 //! A three-link arm for the self-collision rule (as tests/bad_input/cells/self_collide.xml): a fixed
 //! base (base_box), hinges j1 about z at (0, 0, 0.2) (l1_box), j2 about y at 0.4 m (l2_box, 0.6 m up)
 //! and j3 about y at 1.0 m (l3_box, 0.6 m along +x at zero), a body 'tool' welded to link3 (tool_box,

@@ -142,9 +142,8 @@ class SegmentRepair {
     budget_.leaf_limit = leaf_limit;
     // A stretch of a long segment that fails is not cut along the path: each shorter stretch
     // would prove the whole box of the joints again, and its joint splits go further with the
-    // whole remaining budget. A dense path's short segments still cut: there the shorter
-    // stretches are proven once and kept (proven_) through the shrink steps (docs/algorithm.md,
-    // "The region to prove free").
+    // whole remaining budget. A dense path's short segments still cut: there cutting saves leaves
+    // (docs/algorithm.md, "The region to prove free").
     budget_.split_path_on_failure = short_;
   }
 

@@ -1151,6 +1151,36 @@ TEST_F(CertifyTest, AStretchWhoseHullIsNotFreeIsCutUnlessTheBudgetSaysNot) {
   EXPECT_EQ(scene.geom_label(failure.obstacle_geom), "block");
 }
 
+// Which joints turn last (Certifier::turns_last), worked from the models: on the IRB 6700 every
+// geom j6 moves (link 6, the gripper, the carried patch) is fixed on j6's body and has a pivot
+// cylinder about j6; j5 and j4 also move geoms whose last joint is a later one, j1 all of them. On
+// the one-link arm j1 is the only joint and turns its one link last. The rail is a slide and moves
+// every link. Without pivot boxes (or with another bound) no joint turns last.
+TEST_F(CertifyTest, TheLastHingeTurnsLastAndNoOtherJointDoes) {
+  auto index = [](const Scene& scene, const std::string& name) {
+    const auto names = scene.joint_names();
+    return static_cast<int>(std::find(names.begin(), names.end(), name) - names.begin());
+  };
+  const Scene dallara = Scene::load(workcell("dallara"));
+  const Certifier irb(dallara);
+  EXPECT_TRUE(irb.turns_last(index(dallara, "j6")));
+  for (const char* name : {"j1", "j2", "j3", "j4", "j5"})
+    EXPECT_FALSE(irb.turns_last(index(dallara, name))) << name;
+  const Scene rail = Scene::load(workcell("rail_hall"));
+  const Certifier on_rail(rail);
+  EXPECT_TRUE(on_rail.turns_last(index(rail, "j6")));
+  EXPECT_FALSE(on_rail.turns_last(index(rail, "rail_x")));
+  test::TempDir dir;
+  const Scene one = Scene::load(dir.write("one_link.xml", one_link_cell(kWall)));
+  EXPECT_TRUE(Certifier(one).turns_last(0));
+  CertifyOptions without;
+  without.pivot_boxes = false;
+  EXPECT_FALSE(Certifier(one, without).turns_last(0));
+  EXPECT_FALSE(Certifier(dallara, without).turns_last(index(dallara, "j6")));
+  EXPECT_THROW(irb.turns_last(6), InputError);
+  EXPECT_THROW(irb.turns_last(-1), InputError);
+}
+
 TEST_F(CertifyTest, HingeBeforeASlideIsBoundedWithTheSlidesTravel) {
   test::TempDir dir;
   const Scene scene = Scene::load(dir.write("telescope.xml", kTelescopeCell));

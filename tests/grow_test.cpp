@@ -152,6 +152,7 @@ TEST_F(GrowTest, LargerGrowthBudgetsReachTheWallLessTheMargin) {
   const std::vector<WaypointBounds> guide = {box(v1(0.0), v1(-0.1), v1(0.1)), box(v1(0.3), v1(0.2), v1(0.4))};
   SafetyParams params;
   params.max_leaves = 64;
+  params.turn = false;  // the rounds' budgets alone (the turn of the last hinge: the test below)
   std::vector<WaypointBounds> b = guide;
   const SafetyReport small = make_safe(scene, b, params);
   ASSERT_TRUE(small.all_passed);
@@ -170,6 +171,29 @@ TEST_F(GrowTest, LargerGrowthBudgetsReachTheWallLessTheMargin) {
   }
   EXPECT_GT(large.grow.stats.leaves, small.grow.stats.leaves);
   EXPECT_GE(sampled_clearance(scene, b, 20000), 0.001 - 1e-9);
+}
+
+// The same arm and budget with the last hinge's turn (safety.turn, the default): j1 is the arm's
+// last hinge (Certifier::turns_last), so before the rounds each side goes straight to its target
+// in one proof of four slab budgets. Nothing lies below: the free side reaches the joint's limit,
+// -3.0 exactly, where the rounds stopped short of it. Toward the wall the probe stops the step short
+// of the touch and the rounds go on from there: never past the touch less the margin.
+TEST_F(GrowTest, TheLastHingeTurnsStraightToItsLimitWhereTheRoundsStopShort) {
+  const Scene scene = Scene::load(dir_.write("one_link.xml", test::one_link_cell(kWall)));
+  const std::vector<WaypointBounds> guide = {box(v1(0.0), v1(-0.1), v1(0.1)), box(v1(0.3), v1(0.2), v1(0.4))};
+  SafetyParams params;
+  params.max_leaves = 64;
+  std::vector<WaypointBounds> b = guide;
+  ASSERT_TRUE(make_safe(scene, b, params).all_passed);
+  for (const auto& w : b) {
+    EXPECT_EQ(w.lower[0], -3.0);
+    EXPECT_LE(w.upper[0], kTouch - kWithinMargin + 1e-9);
+  }
+  EXPECT_GE(sampled_clearance(scene, b, 20000), 0.001 - 1e-9);
+  params.turn = false;
+  b = guide;
+  ASSERT_TRUE(make_safe(scene, b, params).all_passed);
+  for (const auto& w : b) EXPECT_GT(w.lower[0], -3.0 + 0.005);
 }
 
 TEST_F(GrowTest, TwoLinkElbowGrowsToItsTouchLessTheMarginWhenOnlyItGrows) {
@@ -232,6 +256,7 @@ TEST_F(GrowTest, GreedyAndLeverShapesDifferAndBothAreCertified) {
   const std::vector<WaypointBounds> guide = {box(v2(0, 0), v2(-0.05, -0.05), v2(0.05, 0.05))};
   std::vector<WaypointBounds> greedy = guide, lever = guide;
   SafetyParams params;
+  params.turn = false;  // j2 turns last: its turn would take the room first under both shapes
   ASSERT_TRUE(make_safe(scene, greedy, params).all_passed);
   params.shape = "lever";
   ASSERT_TRUE(make_safe(scene, lever, params).all_passed);

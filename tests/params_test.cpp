@@ -84,6 +84,7 @@ Params unusual() {
   p.safety.shape = "lever";
   p.safety.grow_leaves = 2.5;
   p.safety.runs = false;
+  p.safety.turn = false;
   p.cf.windows = 12;
   p.cf.samples = 500;
   p.cf.seed = 18446744073709551615ull;  // the largest seed: JSON must carry all 64 bits
@@ -123,6 +124,7 @@ void expect_equal(const Params& a, const Params& b) {
   EXPECT_EQ(a.safety.shape, b.safety.shape);
   EXPECT_EQ(a.safety.grow_leaves, b.safety.grow_leaves);
   EXPECT_EQ(a.safety.runs, b.safety.runs);
+  EXPECT_EQ(a.safety.turn, b.safety.turn);
   EXPECT_EQ(a.cf.windows, b.cf.windows);
   EXPECT_EQ(a.cf.samples, b.cf.samples);
   EXPECT_EQ(a.cf.seed, b.cf.seed);
@@ -147,11 +149,13 @@ TEST(ParamsJsonTest, KeysAreTheFieldNames) {
   EXPECT_EQ(j.at("bounds").at("linear_axis_tolerance"), 0.05);
   EXPECT_EQ(j.at("cf").at("seed"), 18446744073709551615ull);
   EXPECT_EQ(j.size(), 6u);
-  EXPECT_EQ(j.at("safety").size(), 11u);
+  EXPECT_EQ(j.at("safety").size(), 12u);
   EXPECT_EQ(j.at("safety").at("grow_leaves"), 2.5);
   EXPECT_EQ(to_json(Params{}).at("safety").at("grow_leaves"), 1.0);
   EXPECT_EQ(j.at("safety").at("runs"), false);
   EXPECT_EQ(to_json(Params{}).at("safety").at("runs"), true);
+  EXPECT_EQ(j.at("safety").at("turn"), false);
+  EXPECT_EQ(to_json(Params{}).at("safety").at("turn"), true);
   EXPECT_EQ(j.at("safety").at("mode"), "certified");
   EXPECT_EQ(j.at("safety").at("shape"), "lever");
   EXPECT_EQ(to_json(Params{}).at("safety").at("shape"), "greedy");

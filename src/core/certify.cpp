@@ -533,6 +533,25 @@ bool Certifier::probe(CertifyContext& ctx, const Eigen::VectorXd& lower, const E
   return true;
 }
 
+bool Certifier::turns_last(int joint) const {
+  if (joint < 0 || joint >= scene_->dof()) throw InputError("certify: no joint " + std::to_string(joint));
+  if (!options_.pivot_boxes || options_.bound) return false;
+  bool moves_any = false;
+  for (size_t li = 0; li < links_.size(); ++li) {
+    const std::vector<int>& joints = links_[li].joints;
+    const auto it = std::find(joints.begin(), joints.end(), joint);
+    if (it == joints.end()) continue;
+    moves_any = true;
+    const size_t p = static_cast<size_t>(it - joints.begin());
+    if (p + 1 != joints.size()) return false;
+    const std::vector<int>& mine = pivots_of_[li];
+    const bool cylinder = std::any_of(
+        mine.begin(), mine.end(), [&](int v) { return pivots_[static_cast<size_t>(v)].frozen_from == p; });
+    if (!cylinder) return false;
+  }
+  return moves_any;
+}
+
 const std::vector<int>& Certifier::pairs_for(int grown_joint) const {
   if (grown_joint >= scene_->dof()) throw InputError("certify: no joint " + std::to_string(grown_joint));
   return grown_joint < 0 ? all_pairs_ : pairs_moved_by_[static_cast<size_t>(grown_joint)];

@@ -36,6 +36,9 @@ constexpr int kCertifySteps = 2;
 constexpr long kThinSlabDivisor = 8;
 // A slab's leaf budget: the safety stage's per-test budget over this.
 constexpr long kSlabBudgetDivisor = 2;
+// The one proof that turns a last hinge straight to its target gets the slab budget times this,
+// on a budget of its own (not the waypoint's: a failure leaves the rounds what they had).
+constexpr long kTurnBudgetFactor = 4;
 // Free-range ends are found to this [rad or m].
 constexpr double kFreeRangeTolerance = 1e-4;
 
@@ -128,6 +131,21 @@ class WaypointGrowth {
         extent, candidate, limited, slab_leaves_,
         [&](double to, long leaves) { return slab_free(i, side, to, leaves); },
         [&](double to) { set(i, side, to); });
+  }
+
+  // Widens one side of joint i straight to `target` (or the probe's limit short of it) in one
+  // proof of `leaves`: for a joint that turns last (Certifier::turns_last) the pivot cylinder
+  // proves a wide slab for the price of a thin one, where the geoms' own bounds would need the
+  // joint split finely. Nothing changes when the proof fails.
+  void turn(int i, int side, double target, double tolerance, long leaves) {
+    const double extent = current(i, side);
+    if (!(target > extent + tolerance)) return;
+    double candidate = target;
+    if (!probe(i, side, target)) {
+      candidate = probe_limit(extent, target, tolerance, [&](double to) { return probe(i, side, to); });
+      if (!(candidate > extent + tolerance)) return;
+    }
+    if (slab_free(i, side, candidate, leaves)) set(i, side, candidate);
   }
 
   double current(int i, int side) const {
@@ -490,6 +508,36 @@ long scaled(long leaves, double factor) {
   return std::max(1L, static_cast<long>(std::llround(static_cast<double>(leaves) * factor)));
 }
 
+// Before the rounds: every joint that turns last (Certifier::turns_last) is widened at each growing
+// waypoint straight to its targets, one proof per side (WaypointGrowth::turn), even waypoints in
+// parallel, then odd ones. Its leaves go to `stats`, apart from the waypoints' growth budgets.
+void turn_last_hinges(const Scene& scene, const Certifier& certifier, std::vector<WaypointBounds>& bounds,
+                      const std::vector<bool>& grows, const std::vector<bool>& mask,
+                      const std::vector<WaypointTargets>& targets, long slab_leaves, int threads,
+                      std::vector<CertifyStats>& stats) {
+  const size_t count = bounds.size();
+  const long leaves = kTurnBudgetFactor * slab_leaves;
+  for (int i = 0; i < scene.dof(); ++i) {
+    if (!mask[static_cast<size_t>(i)] || scene.joints()[static_cast<size_t>(i)].prismatic ||
+        !certifier.turns_last(i))
+      continue;
+    for (size_t parity = 0; parity < 2; ++parity) {
+      std::vector<size_t> jobs;
+      for (size_t k = parity; k < count; k += 2)
+        if (grows[k]) jobs.push_back(k);
+      detail::parallel_for(static_cast<int>(jobs.size()), threads, [&] {
+        auto ctx = std::make_shared<CertifyContext>(scene);
+        return [&, ctx, i](int job) {
+          const size_t k = jobs[static_cast<size_t>(job)];
+          WaypointGrowth growth(certifier, *ctx, 2 * leaves + 1, bounds, k, 0, stats[k]);
+          for (int side = 0; side < 2; ++side)
+            growth.turn(i, side, side ? targets[k].above[i] : targets[k].below[i], kHingeTolerance, leaves);
+        };
+      });
+    }
+  }
+}
+
 }  // namespace
 
 GrowReport grow_bounds(const Scene& scene, std::vector<WaypointBounds>& bounds,
@@ -536,6 +584,9 @@ GrowReport grow_bounds(const Scene& scene, std::vector<WaypointBounds>& bounds,
     if (s + 1 < count) budget[s + 1] += half;
   }
   for (long& b : budget) b = scaled(b, params.grow_leaves);
+  std::vector<CertifyStats> turn_stats(count);
+  if (params.turn)
+    turn_last_hinges(scene, certifier, bounds, grows, mask, targets, slab_leaves, threads, turn_stats);
   // A waypoint's slabs read its neighbours' bounds: even waypoints grow in parallel, then odd ones.
   for (double fraction : lever ? kLeverFractions : kRoundFractions)
     for (size_t parity = 0; parity < 2; ++parity) {
@@ -562,6 +613,7 @@ GrowReport grow_bounds(const Scene& scene, std::vector<WaypointBounds>& bounds,
         };
       });
     }
+  for (const CertifyStats& st : turn_stats) report.stats.add(st);
   for (const CertifyStats& st : stats) report.stats.add(st);
   report.grown = grown_intervals(bounds);
   report.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -66,6 +66,7 @@ void for_each_field(P& p, F&& f) {
   f("safety", "max_half_width", p.safety.max_half_width);
   f("safety", "shape", p.safety.shape);
   f("safety", "grow_leaves", p.safety.grow_leaves);
+  f("safety", "turn", p.safety.turn);
   f("safety", "runs", p.safety.runs);
 }
 

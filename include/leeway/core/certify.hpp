@@ -159,6 +159,13 @@ class Certifier {
   bool leaf_free(CertifyContext& ctx, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
                  CertifyStats& stats, CertifyFailure* failure = nullptr) const;
 
+  //! Whether a box's proof can hold joint `joint` at any width for the price of none: every robot
+  //! geom the joint moves is fixed on the joint's body (the joint is the last on its chain), and
+  //! the pivot cylinder about the joint holds it (docs/algorithm.md, "Pivot boxes"), which the
+  //! certificate tries when the geom's own bound fails. False without pivot boxes (or with another
+  //! bound), and for a joint that moves no geom. @throws InputError for a joint out of range.
+  bool turns_last(int joint) const;
+
   //! How many pairs each leaf proves: (link, obstacle) pairs and robot self pairs.
   int obstacle_pair_count() const { return obstacle_pairs_; }
   int self_pair_count() const { return static_cast<int>(self_pairs_.size()); }

@@ -135,6 +135,11 @@ struct SafetyParams {
   //! Certified mode: growth's leaf budgets (each slab's and each waypoint's or block's in all) as a
   //! multiple of their defaults; more buys room with time (docs/results.md, "Room for time").
   double grow_leaves = 1.0;
+  //! Certified mode: before the rounds, a joint that turns last (the robot's last hinge, every geom
+  //! it moves held by the pivot cylinder about it) grows straight to its target in one proof per
+  //! side (docs/algorithm.md, "Growing beyond the guide", step 3); false: it grows in the rounds
+  //! only, as every other joint.
+  bool turn = true;
   //! Certified mode, dense paths: a warm segment inside its chain's run box (one proven box for up
   //! to 16 waypoints ahead) needs no proof of its own, and a chain does not retry a widening the
   //! certificate refused (docs/algorithm.md, "Run boxes"); false: every segment is proven on its

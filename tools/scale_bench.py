@@ -14,7 +14,7 @@ With --compare-runs, each path is also bounded once with `safety.runs` = false (
 the dense path proven on its own, as before run boxes; docs/algorithm.md, "Run boxes"), and a
 second table compares the two: wall and CPU time, leaves, and each joint's mean interval width.
 With --compare-grow, each path is also bounded once with `--grow none` (the certified bounds
-without growth by blocks; docs/algorithm.md, "Growing beyond the guide", step 7), and a table
+without growth by blocks; docs/algorithm.md, "Growing beyond the guide", step 8), and a table
 compares the two: wall and CPU time, the growth's leaves, and the room (the mean kept share of each
 joint's one-joint free range, leeway's room measure).
 

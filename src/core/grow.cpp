@@ -181,7 +181,8 @@ class WaypointGrowth {
   // the last bit, and the new one is what set() writes.
   bool slab_free(int i, int side, double to, long leaves) {
     // A stretch that fails is not cut into shorter ones: growth's slabs go further for the same
-    // leaves when each stretch's joint splits get the whole budget (docs/algorithm.md, step 4).
+    // leaves when each stretch's joint splits get the whole budget (docs/algorithm.md, "Growing beyond the
+    // guide", step 5).
     const CertifyBudget slab{std::max(64L, leaves), leaf_limit_, false};
     bool free = true;
     for (const auto& [p, r] : segments_) {

@@ -119,14 +119,9 @@ class WaypointGrowth {
   // stopped short (the probe or the certificate said no), so later rounds need not try again.
   bool grow(int i, int side, double target, double tolerance) {
     const double extent = current(i, side);
-    if (!(target > extent + tolerance)) return false;
-    double candidate = target;
     bool limited = false;
-    if (!probe(i, side, target)) {
-      candidate = probe_limit(extent, target, tolerance, [&](double to) { return probe(i, side, to); });
-      limited = true;
-      if (!(candidate > extent + tolerance)) return true;
-    }
+    const double candidate = step_end(i, side, target, tolerance, limited);
+    if (!(candidate > extent + tolerance)) return limited;
     return certify_step(
         extent, candidate, limited, slab_leaves_,
         [&](double to, long leaves) { return slab_free(i, side, to, leaves); },
@@ -138,14 +133,10 @@ class WaypointGrowth {
   // proves a wide slab for the price of a thin one, where the geoms' own bounds would need the
   // joint split finely. Nothing changes when the proof fails.
   void turn(int i, int side, double target, double tolerance, long leaves) {
-    const double extent = current(i, side);
-    if (!(target > extent + tolerance)) return;
-    double candidate = target;
-    if (!probe(i, side, target)) {
-      candidate = probe_limit(extent, target, tolerance, [&](double to) { return probe(i, side, to); });
-      if (!(candidate > extent + tolerance)) return;
-    }
-    if (slab_free(i, side, candidate, leaves)) set(i, side, candidate);
+    bool limited = false;
+    const double candidate = step_end(i, side, target, tolerance, limited);
+    if (candidate > current(i, side) + tolerance && slab_free(i, side, candidate, leaves))
+      set(i, side, candidate);
   }
 
   double current(int i, int side) const {
@@ -157,6 +148,17 @@ class WaypointGrowth {
   }
 
  private:
+  // Where a step of one side of joint i toward `target` ends: the target when the probe accepts it,
+  // else the probe's limit short of it (`limited` set); the current extent when the target is
+  // within `tolerance` of it.
+  double step_end(int i, int side, double target, double tolerance, bool& limited) {
+    limited = false;
+    const double extent = current(i, side);
+    if (!(target > extent + tolerance) || probe(i, side, target)) return std::max(extent, target);
+    limited = true;
+    return probe_limit(extent, target, tolerance, [&](double to) { return probe(i, side, to); });
+  }
+
   // The probe (Certifier::segment_probe) of every segment at this waypoint with the extent set. Only
   // the pairs joint i moves: a configuration the step adds is one of the certified region with joint
   // i moved (the other pairs' geometry does not change), so they are apart there as well.
@@ -509,6 +511,22 @@ long scaled(long leaves, double factor) {
   return std::max(1L, static_cast<long>(std::llround(static_cast<double>(leaves) * factor)));
 }
 
+// Calls grow_one(k, ctx) at every waypoint k that grows, with a certificate context of the calling
+// thread: even waypoints in parallel, then odd ones (a waypoint's slabs read its neighbours' bounds).
+template <class GrowOne>
+void each_growing_waypoint(const Scene& scene, const std::vector<bool>& grows, int threads,
+                           GrowOne grow_one) {
+  for (size_t parity = 0; parity < 2; ++parity) {
+    std::vector<size_t> jobs;
+    for (size_t k = parity; k < grows.size(); k += 2)
+      if (grows[k]) jobs.push_back(k);
+    detail::parallel_for(static_cast<int>(jobs.size()), threads, [&] {
+      auto ctx = std::make_shared<CertifyContext>(scene);
+      return [&, ctx](int job) { grow_one(jobs[static_cast<size_t>(job)], *ctx); };
+    });
+  }
+}
+
 // Before the rounds: every joint that turns last (Certifier::turns_last) is widened at each growing
 // waypoint straight to its targets, one proof per side (WaypointGrowth::turn), even waypoints in
 // parallel, then odd ones. Its leaves go to `stats`, apart from the waypoints' growth budgets.
@@ -516,26 +534,16 @@ void turn_last_hinges(const Scene& scene, const Certifier& certifier, std::vecto
                       const std::vector<bool>& grows, const std::vector<bool>& mask,
                       const std::vector<WaypointTargets>& targets, long slab_leaves, int threads,
                       std::vector<CertifyStats>& stats) {
-  const size_t count = bounds.size();
   const long leaves = kTurnBudgetFactor * slab_leaves;
   for (int i = 0; i < scene.dof(); ++i) {
     if (!mask[static_cast<size_t>(i)] || scene.joints()[static_cast<size_t>(i)].prismatic ||
         !certifier.turns_last(i))
       continue;
-    for (size_t parity = 0; parity < 2; ++parity) {
-      std::vector<size_t> jobs;
-      for (size_t k = parity; k < count; k += 2)
-        if (grows[k]) jobs.push_back(k);
-      detail::parallel_for(static_cast<int>(jobs.size()), threads, [&] {
-        auto ctx = std::make_shared<CertifyContext>(scene);
-        return [&, ctx, i](int job) {
-          const size_t k = jobs[static_cast<size_t>(job)];
-          WaypointGrowth growth(certifier, *ctx, 2 * leaves + 1, bounds, k, 0, stats[k]);
-          for (int side = 0; side < 2; ++side)
-            growth.turn(i, side, side ? targets[k].above[i] : targets[k].below[i], kHingeTolerance, leaves);
-        };
-      });
-    }
+    each_growing_waypoint(scene, grows, threads, [&](size_t k, CertifyContext& ctx) {
+      WaypointGrowth growth(certifier, ctx, 2 * leaves + 1, bounds, k, 0, stats[k]);
+      for (int side = 0; side < 2; ++side)
+        growth.turn(i, side, side ? targets[k].above[i] : targets[k].below[i], kHingeTolerance, leaves);
+    });
   }
 }
 
@@ -588,32 +596,22 @@ GrowReport grow_bounds(const Scene& scene, std::vector<WaypointBounds>& bounds,
   std::vector<CertifyStats> turn_stats(count);
   if (params.turn)
     turn_last_hinges(scene, certifier, bounds, grows, mask, targets, slab_leaves, threads, turn_stats);
-  // A waypoint's slabs read its neighbours' bounds: even waypoints grow in parallel, then odd ones.
   for (double fraction : lever ? kLeverFractions : kRoundFractions)
-    for (size_t parity = 0; parity < 2; ++parity) {
-      std::vector<size_t> jobs;
-      for (size_t k = parity; k < count; k += 2)
-        if (grows[k]) jobs.push_back(k);
-      detail::parallel_for(static_cast<int>(jobs.size()), threads, [&] {
-        auto ctx = std::make_shared<CertifyContext>(scene);
-        return [&, ctx](int job) {
-          const size_t k = jobs[static_cast<size_t>(job)];
-          WaypointGrowth growth(certifier, *ctx, std::max(1L, budget[k]), bounds, k, slab_leaves, stats[k]);
-          const WaypointTargets& target = targets[k];
-          for (int i : target.order) {
-            if (!mask[static_cast<size_t>(i)]) continue;
-            const double tolerance =
-                scene.joints()[static_cast<size_t>(i)].prismatic ? kSlideTolerance : kHingeTolerance;
-            for (int side = 0; side < 2; ++side) {
-              char& stopped = blocked[k][static_cast<size_t>(2 * i + side)];
-              if (stopped) continue;
-              const double aim = fraction * (side ? target.above[i] : target.below[i]);
-              if (growth.grow(i, side, aim, tolerance)) stopped = 1;
-            }
-          }
-        };
-      });
-    }
+    each_growing_waypoint(scene, grows, threads, [&](size_t k, CertifyContext& ctx) {
+      WaypointGrowth growth(certifier, ctx, std::max(1L, budget[k]), bounds, k, slab_leaves, stats[k]);
+      const WaypointTargets& target = targets[k];
+      for (int i : target.order) {
+        if (!mask[static_cast<size_t>(i)]) continue;
+        const double tolerance =
+            scene.joints()[static_cast<size_t>(i)].prismatic ? kSlideTolerance : kHingeTolerance;
+        for (int side = 0; side < 2; ++side) {
+          char& stopped = blocked[k][static_cast<size_t>(2 * i + side)];
+          if (stopped) continue;
+          const double aim = fraction * (side ? target.above[i] : target.below[i]);
+          if (growth.grow(i, side, aim, tolerance)) stopped = 1;
+        }
+      }
+    });
   for (const CertifyStats& st : turn_stats) report.stats.add(st);
   for (const CertifyStats& st : stats) report.stats.add(st);
   report.grown = grown_intervals(bounds);

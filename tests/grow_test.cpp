@@ -228,6 +228,87 @@ bool recertified(const Scene& scene, const WaypointBounds& w) {
   return certifier.segment_free(ctx, w.lower, w.upper, w.lower, w.upper, CertifyBudget{1 << 20}, stats);
 }
 
+// A wrist over a table: j1-j3 (held, zero width) at (0, 0, 1), j4 tilting about x, j5 turning
+// about z and carrying a square plate centred on both axes (half-size 0.3 x 0.3 x 0.01); the table's
+// top is the plane z = 0.85, 0.15 m below the axes. Tilted by a, the plate turned by up to 0.1 rad
+// reaches 0.3 (cos 0.1 + sin 0.1) sin a + 0.01 cos a below the axes; turned freely (the pivot
+// cylinder, radius 0.3 sqrt 2) r sin a + 0.01 cos a: at j4 = 0.4 that is 0.1744 m, past the table.
+const char* kTiltTurn = R"(<mujoco model="tilt-turn">
+  <compiler angle="radian" autolimits="true"/>
+  <worldbody>
+    <geom name="table" type="box" size="1 1 0.05" pos="0 0 0.8"/>
+    <body name="b1" pos="0 0 1">
+      <joint name="j1" type="hinge" axis="0 0 1" range="-3 3"/>
+      <inertial pos="0 0 0" mass="1" diaginertia="0.1 0.1 0.1"/>
+      <body name="b2">
+        <joint name="j2" type="hinge" axis="0 1 0" range="-3 3"/>
+        <inertial pos="0 0 0" mass="1" diaginertia="0.1 0.1 0.1"/>
+        <body name="b3">
+          <joint name="j3" type="hinge" axis="0 1 0" range="-3 3"/>
+          <inertial pos="0 0 0" mass="1" diaginertia="0.1 0.1 0.1"/>
+          <body name="tilt">
+            <joint name="j4" type="hinge" axis="1 0 0" range="-1.5 1.5"/>
+            <inertial pos="0 0 0" mass="1" diaginertia="0.1 0.1 0.1"/>
+            <body name="plate">
+              <joint name="j5" type="hinge" axis="0 0 1" range="-3 3"/>
+              <geom name="plate_box" type="box" size="0.3 0.3 0.01"/>
+              <site name="tool0"/>
+            </body>
+          </body>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+)";
+
+// The guide holds j4 in [-0.4, 0.4] and j5 in [-0.1, 0.1]: the plate then stays 0.15 - 0.1371 m
+// above the table, and the certified mode keeps the box. j5 turns last, but not with j4 at 0.4 (a
+// configuration of that turn comes within the margin of the table: checked below), so j4, the
+// wrist hinge before it, keeps a quarter of its extents, 0.1, and j5 turns to its limits. The rounds
+// then grow j4 back, never past the pivot cylinder's touch less the margin: r sin a + 0.01 cos a =
+// 0.149. Without the turn (safety.turn false) j5 stays short of its limits.
+TEST_F(GrowTest, TheWristGivesUpThreeQuartersWhereTheLastHingeCannotTurnOtherwise) {
+  const Scene scene = Scene::load(dir_.write("tilt_turn.xml", kTiltTurn));
+  const double r = 0.3 * std::sqrt(2.0);
+  const double cylinder_touch = std::asin(0.149 / std::hypot(r, 0.01)) - std::atan2(0.01, r);
+  ASSERT_NEAR(cylinder_touch, 0.33516, 1e-4);
+  RobotState state(scene);
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(5);
+  q[3] = 0.4;
+  q[4] = std::atan(1.0);
+  ASSERT_LT(state.clearance(q).distance, 0.001);
+  q[3] = 0.0;
+  q[4] = 0.0;
+  Eigen::VectorXd lower = q, upper = q;
+  lower[3] = -0.4;
+  upper[3] = 0.4;
+  lower[4] = -0.1;
+  upper[4] = 0.1;
+  const std::vector<WaypointBounds> guide = {box(q, lower, upper)};
+  SafetyParams params;
+  params.grow = "j4,j5";
+  std::vector<WaypointBounds> b = guide;
+  ASSERT_TRUE(make_safe(scene, b, params).all_passed);
+  EXPECT_EQ(b[0].lower[4], -3.0);
+  EXPECT_EQ(b[0].upper[4], 3.0);
+  EXPECT_LE(b[0].lower[3], -0.1 + 1e-12);
+  EXPECT_GE(b[0].upper[3], 0.1 - 1e-12);
+  EXPECT_GE(b[0].lower[3], -cylinder_touch - 1e-9);
+  EXPECT_LE(b[0].upper[3], cylinder_touch + 1e-9);
+  for (int j = 0; j < 3; ++j) {
+    EXPECT_EQ(b[0].lower[j], 0.0);
+    EXPECT_EQ(b[0].upper[j], 0.0);
+  }
+  EXPECT_TRUE(recertified(scene, b[0]));
+  EXPECT_GE(sampled_clearance(scene, b, 20000), 0.001 - 1e-9);
+  params.turn = false;
+  b = guide;
+  ASSERT_TRUE(make_safe(scene, b, params).all_passed);
+  EXPECT_GT(b[0].lower[4], -3.0 + 0.005);
+  EXPECT_LT(b[0].upper[4], 3.0 - 0.005);
+}
+
 // The lever shape on the two-link arm: j2's share costs the tool 0.5 m per radian of its free
 // range (about 3.5 rad), j1's 1.5 m per radian (about 2.8 rad), so j2 grows first, and straight to
 // its free range's end with j1 still within its guide: the touch at j1 = 0.05 less the margin.

@@ -39,6 +39,14 @@ constexpr long kSlabBudgetDivisor = 2;
 // The one proof that turns a last hinge straight to its target gets the slab budget times this,
 // on a budget of its own (not the waypoint's: a failure leaves the rounds what they had).
 constexpr long kTurnBudgetFactor = 4;
+// Where a last hinge cannot turn with the box it has, the wrist hinges before it keep this share of
+// their extents at that waypoint and the turn is tried once more (docs/algorithm.md, "Growing beyond
+// the guide", step 3): a quarter kept the most room on the 15 sparse paths (CHANGELOG.md).
+constexpr double kWristKept = 0.25;
+// The turn's quick test looks at the slab's corners at this many points along each segment.
+constexpr int kTurnCornerSteps = 16;
+// ... and at the corners of at most this many moving joints (the others keep their intervals).
+constexpr int kTurnCornerJoints = 8;
 // Free-range ends are found to this [rad or m].
 constexpr double kFreeRangeTolerance = 1e-4;
 
@@ -131,12 +139,47 @@ class WaypointGrowth {
   // Widens one side of joint i straight to `target` (or the probe's limit short of it) in one
   // proof of `leaves`: for a joint that turns last (Certifier::turns_last) the pivot cylinder
   // proves a wide slab for the price of a thin one, where the geoms' own bounds would need the
-  // joint split finely. Nothing changes when the proof fails.
-  void turn(int i, int side, double target, double tolerance, long leaves) {
+  // joint split finely. Nothing changes when the proof fails. False when it failed (true when the
+  // side had no step to take).
+  bool turn(int i, int side, double target, double tolerance, long leaves) {
     bool limited = false;
     const double candidate = step_end(i, side, target, tolerance, limited);
-    if (candidate > current(i, side) + tolerance && slab_free(i, side, candidate, leaves))
-      set(i, side, candidate);
+    if (!(candidate > current(i, side) + tolerance)) return true;
+    if (!slab_free(i, side, candidate, leaves)) return false;
+    set(i, side, candidate);
+    return true;
+  }
+
+  // A quick test, not a proof, of the slab that turn(i, side, target) would prove: one leaf at each
+  // corner of the slab's box (joint i over the whole slab, the other joints at their bounds) at
+  // kTurnCornerSteps points along each segment. False when a leaf is not proven: the pivot cylinder
+  // does not hold the geoms there, and the proof could only split joint i finely, which costs a
+  // wide turn most of its budget (measured on the 15 sparse paths: CHANGELOG.md).
+  bool turn_corners_free(int i, int side, double target, double tolerance) {
+    bool limited = false;
+    const double to = step_end(i, side, target, tolerance, limited);
+    if (!(to > current(i, side) + tolerance)) return true;
+    for (const auto& [p, r] : segments_) {
+      Eigen::VectorXd lo[2], hi[2];
+      slab_ends(i, side, to, p, r, lo, hi);
+      for (int step = 0; step < kTurnCornerSteps; ++step) {
+        // From this waypoint's end, where the slab is widest, toward the other end.
+        const double f = static_cast<double>(step) / kTurnCornerSteps;
+        const double t = p == k_ ? f : 1 - f;
+        const Eigen::VectorXd l = (1 - t) * lo[0] + t * lo[1], h = (1 - t) * hi[0] + t * hi[1];
+        std::vector<int> moving;
+        for (int j = 0; j < static_cast<int>(l.size()); ++j)
+          if (j != i && h[j] > l[j] && static_cast<int>(moving.size()) < kTurnCornerJoints)
+            moving.push_back(j);
+        Eigen::VectorXd cl = l, ch = h;
+        for (unsigned corner = 0; corner < (1u << moving.size()); ++corner) {
+          for (size_t b = 0; b < moving.size(); ++b)
+            cl[moving[b]] = ch[moving[b]] = (corner >> b) & 1u ? h[moving[b]] : l[moving[b]];
+          if (!certifier_.leaf_free(ctx_, cl, ch, stats_)) return false;
+        }
+      }
+    }
+    return true;
   }
 
   double current(int i, int side) const {
@@ -188,18 +231,28 @@ class WaypointGrowth {
     const CertifyBudget slab{std::max(64L, leaves), leaf_limit_, false};
     bool free = true;
     for (const auto& [p, r] : segments_) {
-      Eigen::VectorXd lo[2] = {b_[p].lower, b_[r].lower}, hi[2] = {b_[p].upper, b_[r].upper};
-      for (int end = 0; end < 2; ++end) {
-        const WaypointBounds& w = b_[end ? r : p];
-        const double old_bound = side ? w.upper[i] : w.lower[i];
-        const double new_bound = (end ? r : p) != k_ ? old_bound : bound(i, side, to);
-        lo[end][i] = side ? old_bound : new_bound;
-        hi[end][i] = side ? new_bound : old_bound;
-      }
+      Eigen::VectorXd lo[2], hi[2];
+      slab_ends(i, side, to, p, r, lo, hi);
       free = certifier_.segment_free(ctx_, lo[0], hi[0], lo[1], hi[1], slab, stats_, nullptr, nullptr, i);
       if (!free) break;
     }
     return free;
+  }
+
+  // The slab's bounds at the ends of segment (p, r): the segment's own, with joint i between the
+  // old bound and the new one at this waypoint (`to` from the nominal value), at the old bound at
+  // the other end.
+  void slab_ends(int i, int side, double to, size_t p, size_t r, Eigen::VectorXd lo[2],
+                 Eigen::VectorXd hi[2]) const {
+    for (int end = 0; end < 2; ++end) {
+      const WaypointBounds& w = b_[end ? r : p];
+      lo[end] = w.lower;
+      hi[end] = w.upper;
+      const double old_bound = side ? w.upper[i] : w.lower[i];
+      const double new_bound = (end ? r : p) != k_ ? old_bound : bound(i, side, to);
+      lo[end][i] = side ? old_bound : new_bound;
+      hi[end][i] = side ? new_bound : old_bound;
+    }
   }
 
   // This waypoint's bound of joint i on `side` at `extent` from the nominal value.
@@ -527,9 +580,27 @@ void each_growing_waypoint(const Scene& scene, const std::vector<bool>& grows, i
   }
 }
 
-// Before the rounds: every joint that turns last (Certifier::turns_last) is widened at each growing
-// waypoint straight to its targets, one proof per side (WaypointGrowth::turn), even waypoints in
-// parallel, then odd ones. Its leaves go to `stats`, apart from the waypoints' growth budgets.
+// The wrist of a joint i that turns last: the hinges before it that growth may change (`mask`),
+// after the arm's first three hinges (the joints the guide bisects by default, which the turn does
+// not narrow).
+std::vector<int> wrist_before(const Scene& scene, const std::vector<bool>& mask, int i) {
+  std::vector<int> wrist;
+  int hinges = 0;
+  for (int j = 0; j < i; ++j) {
+    if (scene.joints()[static_cast<size_t>(j)].prismatic) continue;
+    if (++hinges > 3 && mask[static_cast<size_t>(j)]) wrist.push_back(j);
+  }
+  return wrist;
+}
+
+// Before the rounds: every joint i that turns last (Certifier::turns_last) is widened at each
+// growing waypoint straight to its targets (WaypointGrowth::turn), even waypoints in parallel, then
+// odd ones. One proof per side, the upper side only when the lower one was proven (the pivot
+// cylinder that proves one side proves the other: when one runs out of leaves, the other almost
+// always does too). Where i has a wrist (wrist_before) and the quick corner test or the lower side
+// fails, the wrist keeps kWristKept of its extents at that waypoint and the turn is tried once
+// more; when that fails as well, the waypoint's bounds are restored. Leaves go to `stats`, apart
+// from the waypoints' growth budgets.
 void turn_last_hinges(const Scene& scene, const Certifier& certifier, std::vector<WaypointBounds>& bounds,
                       const std::vector<bool>& grows, const std::vector<bool>& mask,
                       const std::vector<WaypointTargets>& targets, long slab_leaves, int threads,
@@ -539,10 +610,28 @@ void turn_last_hinges(const Scene& scene, const Certifier& certifier, std::vecto
     if (!mask[static_cast<size_t>(i)] || scene.joints()[static_cast<size_t>(i)].prismatic ||
         !certifier.turns_last(i))
       continue;
+    const std::vector<int> wrist = wrist_before(scene, mask, i);
     each_growing_waypoint(scene, grows, threads, [&](size_t k, CertifyContext& ctx) {
-      WaypointGrowth growth(certifier, ctx, 2 * leaves + 1, bounds, k, 0, stats[k]);
-      for (int side = 0; side < 2; ++side)
-        growth.turn(i, side, side ? targets[k].above[i] : targets[k].below[i], kHingeTolerance, leaves);
+      // Two tries of two sides and the corner tests.
+      WaypointGrowth growth(certifier, ctx, 5 * leaves, bounds, k, 0, stats[k]);
+      const WaypointTargets& target = targets[k];
+      auto turn_both = [&] {
+        if (!growth.turn(i, 0, target.below[i], kHingeTolerance, leaves)) return false;
+        growth.turn(i, 1, target.above[i], kHingeTolerance, leaves);
+        return true;
+      };
+      if (wrist.empty()) {
+        turn_both();
+        return;
+      }
+      if (growth.turn_corners_free(i, 0, target.below[i], kHingeTolerance) && turn_both()) return;
+      WaypointBounds& w = bounds[k];
+      const WaypointBounds kept = w;
+      for (int j : wrist) {
+        w.lower[j] = w.q[j] - kWristKept * (w.q[j] - w.lower[j]);
+        w.upper[j] = w.q[j] + kWristKept * (w.upper[j] - w.q[j]);
+      }
+      if (!turn_both()) w = kept;
     });
   }
 }

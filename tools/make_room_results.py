@@ -117,7 +117,8 @@ def render(data):
           f"{pct(med('certified', 'mean_share'))} %, grown {pct(med('grown', 'mean_share'))} % (our "
           f"target: >= 30 %, {'met' if med('grown', 'mean_share') >= 0.30 else 'not met'}).",
           f"- j1-j3 share: grown is lower than certified by at most {drop:.1f} points on any path (growth "
-          "never narrows an interval). Growth added less than 0.1 point on "
+          "never narrows j1-j3: only the wrist gives way, where the last hinge turns; docs/algorithm.md, "
+          "\"Growing beyond the guide\", step 3). Growth added less than 0.1 point on "
           f"{same} of the {len(rows)} paths.",
           f"- Safety stage over the {len(rows)} paths (one thread): certified {tot('certified') / 1000:.1f} s, "
           f"grown {tot('grown') / 1000:.1f} s ({tot('grown') / tot('certified'):.2f} x).",

@@ -136,28 +136,30 @@ class WaypointGrowth {
         [&](double to) { set(i, side, to); });
   }
 
-  // Widens one side of joint i straight to `target` (or the probe's limit short of it) in one
-  // proof of `leaves`: for a joint that turns last (Certifier::turns_last) the pivot cylinder
-  // proves a wide slab for the price of a thin one, where the geoms' own bounds would need the
-  // joint split finely. Nothing changes when the proof fails. False when it failed (true when the
-  // side had no step to take).
-  bool turn(int i, int side, double target, double tolerance, long leaves) {
+  // Where a turn of one side of joint i toward `target` ends: the target, or the probe's limit
+  // short of it (step_end).
+  double turn_end(int i, int side, double target, double tolerance) {
     bool limited = false;
-    const double candidate = step_end(i, side, target, tolerance, limited);
-    if (!(candidate > current(i, side) + tolerance)) return true;
-    if (!slab_free(i, side, candidate, leaves)) return false;
-    set(i, side, candidate);
+    return step_end(i, side, target, tolerance, limited);
+  }
+
+  // Widens one side of joint i straight to `to` (a turn_end) in one proof of `leaves`: for a joint
+  // that turns last (Certifier::turns_last) the pivot cylinder proves a wide slab for the price of a
+  // thin one, where the geoms' own bounds would need the joint split finely. Nothing changes when
+  // the proof fails. False when it failed (true when the side had no step to take).
+  bool turn_to(int i, int side, double to, double tolerance, long leaves) {
+    if (!(to > current(i, side) + tolerance)) return true;
+    if (!slab_free(i, side, to, leaves)) return false;
+    set(i, side, to);
     return true;
   }
 
-  // A quick test, not a proof, of the slab that turn(i, side, target) would prove: one leaf at each
+  // A quick test, not a proof, of the slab that turn_to(i, side, to) would prove: one leaf at each
   // corner of the slab's box (joint i over the whole slab, the other joints at their bounds) at
   // kTurnCornerSteps points along each segment. False when a leaf is not proven: the pivot cylinder
   // does not hold the geoms there, and the proof could only split joint i finely, which costs a
   // wide turn most of its budget (measured on the 15 sparse paths: CHANGELOG.md).
-  bool turn_corners_free(int i, int side, double target, double tolerance) {
-    bool limited = false;
-    const double to = step_end(i, side, target, tolerance, limited);
+  bool turn_corners_free(int i, int side, double to, double tolerance) {
     if (!(to > current(i, side) + tolerance)) return true;
     for (const auto& [p, r] : segments_) {
       Eigen::VectorXd lo[2], hi[2];
@@ -580,16 +582,15 @@ void each_growing_waypoint(const Scene& scene, const std::vector<bool>& grows, i
   }
 }
 
-// The wrist of a joint i that turns last: the hinges before it that growth may change (`mask`),
-// after the arm's first three hinges (the joints the guide bisects by default, which the turn does
-// not narrow).
+// The wrist of a joint i that turns last: the hinges before it that growth may change (`mask`) and
+// that the guide's default rule does not bisect (bound_kinds with default parameters: the arm's first
+// three hinges are bisected, and the turn does not narrow them).
 std::vector<int> wrist_before(const Scene& scene, const std::vector<bool>& mask, int i) {
+  const std::vector<BoundKind> kinds = bound_kinds(scene, BoundsParams{});
   std::vector<int> wrist;
-  int hinges = 0;
-  for (int j = 0; j < i; ++j) {
-    if (scene.joints()[static_cast<size_t>(j)].prismatic) continue;
-    if (++hinges > 3 && mask[static_cast<size_t>(j)]) wrist.push_back(j);
-  }
+  for (int j = 0; j < i; ++j)
+    if (kinds[static_cast<size_t>(j)] == BoundKind::kFixed && mask[static_cast<size_t>(j)])
+      wrist.push_back(j);
   return wrist;
 }
 
@@ -615,23 +616,28 @@ void turn_last_hinges(const Scene& scene, const Certifier& certifier, std::vecto
       // Two tries of two sides and the corner tests.
       WaypointGrowth growth(certifier, ctx, 5 * leaves, bounds, k, 0, stats[k]);
       const WaypointTargets& target = targets[k];
-      auto turn_both = [&] {
-        if (!growth.turn(i, 0, target.below[i], kHingeTolerance, leaves)) return false;
-        growth.turn(i, 1, target.above[i], kHingeTolerance, leaves);
+      // The lower side's end, with the bounds as they are when it is called (the probe's limit
+      // depends on the other joints' intervals).
+      auto lower_end = [&] { return growth.turn_end(i, 0, target.below[i], kHingeTolerance); };
+      auto turn_both = [&](double below) {
+        if (!growth.turn_to(i, 0, below, kHingeTolerance, leaves)) return false;
+        growth.turn_to(i, 1, growth.turn_end(i, 1, target.above[i], kHingeTolerance), kHingeTolerance,
+                       leaves);
         return true;
       };
       if (wrist.empty()) {
-        turn_both();
+        turn_both(lower_end());
         return;
       }
-      if (growth.turn_corners_free(i, 0, target.below[i], kHingeTolerance) && turn_both()) return;
+      const double below = lower_end();
+      if (growth.turn_corners_free(i, 0, below, kHingeTolerance) && turn_both(below)) return;
       WaypointBounds& w = bounds[k];
       const WaypointBounds kept = w;
       for (int j : wrist) {
         w.lower[j] = w.q[j] - kWristKept * (w.q[j] - w.lower[j]);
         w.upper[j] = w.q[j] + kWristKept * (w.upper[j] - w.q[j]);
       }
-      if (!turn_both()) w = kept;
+      if (!turn_both(lower_end())) w = kept;
     });
   }
 }

@@ -24,6 +24,7 @@
 #include "leeway/core/kinematics.hpp"
 #include "leeway/core/scene.hpp"
 #include "lever_bound.hpp"
+#include "stl_util.hpp"
 #include "test_util.hpp"
 
 namespace leeway {
@@ -47,14 +48,15 @@ std::string vec_str(const Eigen::VectorXd& v) {
 
 // The clearance at q by the exact queries: RobotState::clearance for every pair but the planes, which
 // it skips, for each plane obstacle the signed distance of every link box from its half-space
-// (normal = the plane's z axis, surface through its centre), and the exact box distance of every
-// self pair (Scene::self_pairs(); then obstacle_geom is the pair's other robot geom). 0 in contact.
+// (normal = the plane's z axis, surface through its centre), and the exact distance of every
+// self pair's shapes (Scene::self_pairs(); then obstacle_geom is the pair's other robot geom). 0 in contact.
 Clearance exact_clearance(RobotState& state, const Eigen::VectorXd& q) {
   Clearance best = state.clearance(q);  // runs the kinematics at q
   const Scene& scene = state.scene();
   const mjModel& m = scene.model();
   for (const RobotPair& p : scene.self_pairs()) {
-    const double dist = box_distance(geom_box(m, state.data(), p.geom2), geom_box(m, state.data(), p.geom1));
+    const double dist =
+        shape_distance(geom_shape(m, state.data(), p.geom2), geom_shape(m, state.data(), p.geom1));
     if (dist < best.distance) best = {dist, p.geom2, p.geom1};
   }
   for (int o : scene.obstacle_geoms()) {
@@ -64,7 +66,9 @@ Clearance exact_clearance(RobotState& state, const Eigen::VectorXd& q) {
     for (int l : scene.link_geoms()) {
       const Box b = geom_box(m, state.data(), l);
       const double dist =
-          n.dot(b.center - plane.center) - (b.rotation.transpose() * n).cwiseAbs().dot(b.half_size);
+          m.geom_type[l] == mjGEOM_BOX
+              ? n.dot(b.center - plane.center) - (b.rotation.transpose() * n).cwiseAbs().dot(b.half_size)
+              : -geom_shape(m, state.data(), l).support(-n) - n.dot(plane.center);
       if (dist < best.distance) best = {std::max(dist, 0.0), l, o};
     }
   }
@@ -150,8 +154,15 @@ Violation sample_segment(RobotState& state, RegionSource& src, const Eigen::Vect
   Violation v;
   const int n = static_cast<int>(lower_a.size());
   const bool segment = lower_a != lower_b || upper_a != upper_b;
+  // Where the cell has round or mesh geoms, MuJoCo's own collision of the real geoms must agree.
+  const mjModel& m = state.scene().model();
+  bool round = false;
+  for (int g = 0; g < m.ngeom; ++g)
+    round = round || (m.geom_type[g] != mjGEOM_BOX && m.geom_type[g] != mjGEOM_PLANE &&
+                      m.geom_contype[g] + m.geom_conaffinity[g] > 0);
   auto check = [&](const Eigen::VectorXd& q, double t) {
-    const Clearance c = exact_clearance(state, q);
+    Clearance c = exact_clearance(state, q);
+    if (round && state.in_collision(q)) c.distance = -1;  // MuJoCo finds a contact
     v.min_clearance = std::min(v.min_clearance, c.distance);
     if (c.distance >= margin - 1e-9) return false;
     v.found = true;
@@ -309,11 +320,62 @@ const char* kFoldingHandCell = R"(<mujoco model="folding_hand">
 </mujoco>
 )";
 
+// Round and mesh geoms (shape.hpp): a capsule upper arm, a cylinder forearm and a hand that is an
+// STL box off its body's origin (MuJoCo re-centres it), on three hinges; a sphere, a slanted capsule
+// rail, a cylinder pillar, a turned ellipsoid and a triangular prism (an STL mesh) around them.
+const char* kRoundArmCell = R"(<mujoco model="round_arm">
+  <compiler angle="radian" autolimits="true"/>
+  <asset>
+    <mesh name="hand_mesh" file="hand.stl"/>
+    <mesh name="wedge_mesh" file="wedge.stl"/>
+  </asset>
+  <worldbody>
+    <body name="link_1" pos="0 0 0.5">
+      <joint name="j1" type="hinge" axis="0 0 1" range="-2.8 2.8"/>
+      <geom name="upper" type="capsule" fromto="0 0 0 1 0 0" size="0.05"/>
+      <body name="link_2" pos="1 0 0">
+        <joint name="j2" type="hinge" axis="0 1 0" range="-1.5 1.5"/>
+        <geom name="fore" type="cylinder" fromto="0.1 0 0 0.7 0 0" size="0.04"/>
+        <body name="hand" pos="0.8 0 0">
+          <joint name="j3" type="hinge" axis="1 0 0" range="-2.8 2.8"/>
+          <geom name="hand_geom" type="mesh" mesh="hand_mesh"/>
+          <site name="tool0" pos="0.2 0 0"/>
+        </body>
+      </body>
+    </body>
+    <geom name="ball" type="sphere" size="0.15" pos="0.9 0.9 0.5"/>
+    <geom name="rail" type="capsule" fromto="-1 -0.8 0.3 1.5 -0.8 0.6" size="0.05"/>
+    <geom name="pillar" type="cylinder" size="0.1 0.5" pos="-0.7 0.5 0.5"/>
+    <geom name="egg" type="ellipsoid" size="0.2 0.1 0.15" pos="1.6 -0.4 0.4" euler="0.3 0.2 0.5"/>
+    <geom name="wedge" type="mesh" mesh="wedge_mesh" pos="1.3 0.7 0.1" euler="0 0 0.7"/>
+  </worldbody>
+  <keyframe>
+    <key name="home" qpos="0 0 0"/>
+    <key name="reach" qpos="0.6 0.3 1.0"/>
+  </keyframe>
+</mujoco>
+)";
+
+std::string round_arm_cell(const test::TempDir& dir) {
+  test::write_binary_stl((dir.path() / "hand.stl").string(),
+                         test::cuboid(Eigen::Vector3d(0, -0.06, -0.03), Eigen::Vector3d(0.2, 0.08, 0.03)));
+  // A prism over the triangle (0, 0), (0.4, 0), (0, 0.3), from z = 0 to 0.6.
+  const Eigen::Vector3d a(0, 0, 0), b(0.4, 0, 0), c(0, 0.3, 0), up(0, 0, 0.6);
+  std::vector<test::Triangle> wedge = {{a, c, b}, {a + up, b + up, c + up}};
+  for (const auto& [p, q] : {std::pair{a, b}, std::pair{b, c}, std::pair{c, a}}) {
+    wedge.push_back({p, q, q + up});
+    wedge.push_back({p, q + up, p + up});
+  }
+  test::write_binary_stl((dir.path() / "wedge.stl").string(), wedge);
+  return dir.write("round_arm.xml", kRoundArmCell);
+}
+
 std::string cell_path(const test::TempDir& dir, const std::string& name) {
   if (name == "folding_hand") return dir.write("folding_hand.xml", kFoldingHandCell);
   if (name == "one_link") return dir.write("one_link.xml", one_link_cell(kOneLinkObstacles));
   if (name == "hammer") return dir.write("hammer.xml", kHammerPropertyCell);
   if (name == "telescope") return dir.write("telescope.xml", kTelescopeCell);
+  if (name == "round_arm") return round_arm_cell(dir);
   return workcell(name);
 }
 
@@ -579,7 +641,7 @@ TEST_P(CertifyPropertyTest, WideWristRegionsCertifiedWithPivotBoxesAreFree) {
 
 INSTANTIATE_TEST_SUITE_P(CertifyCells, CertifyPropertyTest,
                          ::testing::Values("dallara", "baltico", "dlr", "rail_hall", "wide_elbow", "one_link",
-                                           "hammer", "telescope", "folding_hand"));
+                                           "hammer", "telescope", "folding_hand", "round_arm"));
 
 class CertifyTest : public test::MujocoTest {};
 

@@ -1,5 +1,7 @@
 #include "leeway/core/box.hpp"
 
+#include "leeway/core/shape.hpp"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -149,9 +151,8 @@ Box geom_box(const mjModel& m, const mjData& d, int geom) {
     case mjGEOM_PLANE:
       b.half_size = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
       break;
-    default:
-      b.half_size = Eigen::Vector3d::Constant(m.geom_rbound[geom]);
-      break;
+    default:  // a mesh (its vertices' tight box) or a height field
+      return geom_shape(m, d, geom).box;
   }
   return b;
 }

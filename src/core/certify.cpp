@@ -105,14 +105,8 @@ Certifier::Certifier(const Scene& scene, CertifyOptions options) : scene_(&scene
   // Obstacles are static: their world boxes once.
   state.set(scene.lower_limits().cwiseMax(0).cwiseMin(scene.upper_limits()));
   const mjModel& m = scene.model();
-  for (int g : scene.obstacle_geoms()) {
-    SweepObstacle o;
-    o.geom = g;
-    o.box = geom_box(m, state.data(), g);
-    o.plane = m.geom_type[g] == mjGEOM_PLANE;
-    o.radius = o.plane ? INFINITY : o.box.half_size.norm();
-    obstacles_.push_back(o);
-  }
+  for (int g : scene.obstacle_geoms())
+    obstacles_.push_back(sweep_obstacle(g, geom_shape(m, state.data(), g)));
   add_self_pairs();
   index_pairs();
 }
@@ -138,6 +132,9 @@ void Certifier::add_links(RobotState& state) {
         body_of_joint.push_back(k);
       }
     const Box b0 = geom_box(m, state.data(), g);
+    // The box's centre is the point x of the bound; a mesh's box is centred off the geom's origin.
+    const double offset =
+        vec3(m.geom_pos + 3 * g).norm() + (b0.center - vec3(state.data().geom_xpos + 3 * g)).norm();
     for (size_t p = 0; p < jids.size(); ++p) {
       const int r = robot_index[static_cast<size_t>(jids[p])];
       LEEWAY_DEMAND(r >= 0);  // the scene recognises every joint on a link's chain as a robot joint
@@ -145,7 +142,7 @@ void Certifier::add_links(RobotState& state) {
       link.mj_joints.push_back(jids[p]);
       link.slide.push_back(scene.joints()[static_cast<size_t>(r)].prismatic);
       link.lever.push_back(chain_lever(scene, bodies, jids, body_of_joint, robot_index, p, jids.size(),
-                                       bodies.size(), vec3(m.geom_pos + 3 * g).norm()));
+                                       bodies.size(), offset));
     }
     link.corner_lever = std::isfinite(b0.half_size.norm()) ? b0.half_size.norm() : 0.0;
     pivots_of_.emplace_back();
@@ -323,17 +320,17 @@ bool Certifier::leaf_free(CertifyContext& ctx, const Eigen::VectorXd& lower, con
 // bound; zero on one chain, where the other geom is the ancestor's). docs/algorithm.md
 // ("Self-collision") has the argument.
 SweepObstacle Certifier::other_geom_swept(const CertifyContext& ctx, const SelfPair& pair,
-                                          const Box& at_centre) const {
-  SweepObstacle other;
-  other.geom = pair.other_geom;
-  other.box = at_centre;
+                                          const Shape& at_centre) const {
+  SweepObstacle other = sweep_obstacle(pair.other_geom, at_centre);
   double grow = 0;
   if (pair.other_link >= 0) {
     const LinkChain& ol = links_[static_cast<size_t>(pair.other_link)];
     for (size_t p = static_cast<size_t>(pair.other_shared); p < ol.joints.size(); ++p)
       grow += ctx.half_[ol.joints[p]] * (ol.slide[p] ? 1.0 : ol.lever[p] + ol.corner_lever);
   }
+  if (grow == 0) return other;  // on one chain: the geom as it is
   other.box.half_size.array() += grow;
+  other.shape = box_shape(other.box);
   other.radius = other.box.half_size.norm();
   return other;
 }
@@ -406,7 +403,7 @@ bool Certifier::leaf_free_impl(CertifyContext& ctx, const Eigen::VectorXd& lower
     failure->gap = 0.0;
   }
   SweepObstacle other;  // a self pair's other robot geom, grown by its own motion
-  Box other_at_c;       // ... and as it is at c, for the centre test
+  Shape other_at_c;     // ... and as it is at c, for the centre test
   for (int pair : pairs) {
     ++stats.pair_tests;
     // An obstacle pair (link, obstacle), or a self pair: the link against another robot geom, the
@@ -416,7 +413,7 @@ bool Certifier::leaf_free_impl(CertifyContext& ctx, const Eigen::VectorXd& lower
     const int li = self ? pair_info->link : pair / static_cast<int>(nobs);
     const int held = self ? pair_info->shared : 0;
     if (self) {
-      other_at_c = geom_box(m, d, pair_info->other_geom);
+      other_at_c = geom_shape(m, d, pair_info->other_geom);
       other = other_geom_swept(ctx, *pair_info, other_at_c);
     }
     const SweepObstacle& obs = self ? other : obstacles_[static_cast<size_t>(pair) % nobs];
@@ -442,8 +439,12 @@ bool Certifier::leaf_free_impl(CertifyContext& ctx, const Eigen::VectorXd& lower
       failure->gap = std::min(failure->gap, std::isfinite(sep.gap) ? sep.gap - margin : -1e9);
       if (ctx.failing_.empty()) describe_failure(ctx, lower, upper, obs, self, sep, blame_weights, *failure);
       // Does the centre configuration itself come within the margin? Then no split can help.
-      if (!failure->centre_hits)
-        failure->centre_hits = touches(sweep.box(), margin, self ? other_at_c : obs.box, obs.plane);
+      if (!failure->centre_hits) {
+        const Shape& at_c = self ? other_at_c : obs.shape;
+        failure->centre_hits = sweep.shaped() || !(at_c.is_box() || at_c.plane())
+                                   ? shape_distance(sweep.shape(), at_c) <= margin
+                                   : touches(sweep.box(), margin, at_c.box, at_c.plane());
+      }
     }
     ctx.failing_.push_back(pair);
   }

@@ -8,6 +8,7 @@
 
 #include "leeway/core/box.hpp"
 #include "leeway/core/error.hpp"
+#include "leeway/core/shape.hpp"
 #include "random.hpp"
 
 namespace leeway {
@@ -148,11 +149,12 @@ std::vector<SelfContact> self_contacts_within(RobotState& state, const Eigen::Ve
   std::vector<SelfContact> out = state.self_contacts(q);
   const mjModel& m = state.scene().model();
   for (const RobotPair& p : state.scene().self_pairs()) {
-    if (m.geom_type[p.geom1] != mjGEOM_BOX || m.geom_type[p.geom2] != mjGEOM_BOX) continue;
+    if (m.geom_type[p.geom1] == mjGEOM_PLANE || m.geom_type[p.geom2] == mjGEOM_PLANE) continue;
     if (std::any_of(out.begin(), out.end(),
                     [&](const SelfContact& c) { return c.geom1 == p.geom1 && c.geom2 == p.geom2; }))
       continue;
-    if (box_distance(geom_box(m, state.data(), p.geom1), geom_box(m, state.data(), p.geom2)) <= tolerance)
+    if (shape_distance(geom_shape(m, state.data(), p.geom1), geom_shape(m, state.data(), p.geom2)) <=
+        tolerance)
       out.push_back({p.geom1, p.geom2, 0.0});
   }
   std::stable_sort(out.begin(), out.end(),
@@ -203,9 +205,9 @@ Clearance RobotState::clearance(const Eigen::VectorXd& q) {
   Clearance best;
   for (int o : scene_->obstacle_geoms()) {
     if (!has_bounding_box(m, o)) continue;  // the plane rule, box.hpp
-    const Box ob = geom_box(m, *data_, o);
+    const Shape ob = geom_shape(m, *data_, o);
     for (int l : scene_->link_geoms()) {
-      const double dist = box_distance(geom_box(m, *data_, l), ob);
+      const double dist = shape_distance(geom_shape(m, *data_, l), ob);
       if (dist < best.distance) best = {dist, l, o};
     }
   }

@@ -9,6 +9,7 @@
 #include "leeway/core/box.hpp"
 #include "leeway/core/error.hpp"
 #include "leeway/core/kinematics.hpp"
+#include "leeway/core/shape.hpp"
 #include "parallel.hpp"
 #include "random.hpp"
 
@@ -41,12 +42,12 @@ struct Moved {
   int geom = -1;
   double lever = 1.0;
   bool link = false;  // a link geom: checked against the obstacles
-  Box box;            // at the sweep's current configuration
+  Shape shape;        // at the sweep's current configuration (shape.box holds it)
 };
 
-// A geom the joint does not move (an obstacle, or the other geom of a self pair): its box stays.
+// A geom the joint does not move (an obstacle, or the other geom of a self pair): its shape stays.
 struct Fixed {
-  Box box;
+  Shape shape;
   double margin = 0.0;
 };
 
@@ -69,10 +70,10 @@ Sweep sweep_of(const Scene& scene, const mjData& d, int i) {
   std::vector<int> index(static_cast<size_t>(m.ngeom), -1);
   auto moved = [&](int g) {
     if (index[static_cast<size_t>(g)] >= 0) return static_cast<size_t>(index[static_cast<size_t>(g)]);
-    Moved out{g, 1.0, false, geom_box(m, d, g)};
+    Moved out{g, 1.0, false, geom_shape(m, d, g)};
     if (!joint.prismatic) {
       out.lever = 1e-9;
-      for (const Eigen::Vector3d& corner : box_corners(out.box)) {
+      for (const Eigen::Vector3d& corner : box_corners(out.shape.box)) {
         const Eigen::Vector3d r = corner - anchor;
         out.lever = std::max(out.lever, (r - r.dot(axis) * axis).norm());
       }
@@ -87,25 +88,26 @@ Sweep sweep_of(const Scene& scene, const mjData& d, int i) {
     const bool first = moves_with(m, m.geom_bodyid[p.geom1], joint_body);
     if (first == moves_with(m, m.geom_bodyid[p.geom2], joint_body)) continue;
     const int other = first ? p.geom2 : p.geom1;
-    s.self.emplace_back(moved(first ? p.geom1 : p.geom2), Fixed{geom_box(m, d, other), m.geom_margin[other]});
+    s.self.emplace_back(moved(first ? p.geom1 : p.geom2),
+                        Fixed{geom_shape(m, d, other), m.geom_margin[other]});
   }
   for (int o : scene.obstacle_geoms()) {
     if (has_bounding_box(m, o))
-      s.obstacles.push_back(Fixed{geom_box(m, d, o), m.geom_margin[o]});
+      s.obstacles.push_back(Fixed{geom_shape(m, d, o), m.geom_margin[o]});
     else
       s.planes = true;
   }
   return s;
 }
 
-// A lower bound of how far a moved geom is from touching a fixed one: their boxes' distance less the
-// contact margin. `limit`: a bound the caller needs only when it is smaller (the boxes' bounding
-// spheres answer the rest without the exact distance).
+// A lower bound of how far a moved geom is from touching a fixed one: their shapes' distance (as
+// MuJoCo collides them: shape.hpp) less the contact margin. `limit`: a bound the caller needs only
+// when it is smaller (the shapes' bounding spheres answer the rest without the exact distance).
 double gap(const Moved& g, const Fixed& f, double margin, double limit) {
   const double spheres =
-      (g.box.center - f.box.center).norm() - g.box.half_size.norm() - f.box.half_size.norm() - margin;
+      (g.shape.box.center - f.shape.box.center).norm() - g.shape.radius - f.shape.radius - margin;
   if (spheres >= limit) return spheres;
-  return box_distance(g.box, f.box) - margin;
+  return shape_distance(g.shape, f.shape) - margin;
 }
 
 // How far the joint may move [rad or m] before a geom of `sweep` can touch an obstacle or its
@@ -114,7 +116,7 @@ double gap(const Moved& g, const Fixed& f, double margin, double limit) {
 // whose boxes are apart allows at least kSelfFloor of it. The moved geoms' boxes are updated to the
 // configuration of `d` first.
 double sweep_step(const mjModel& m, const mjData& d, Sweep& sweep, double sampled) {
-  for (Moved& g : sweep.moved) g.box = geom_box(m, d, g.geom);
+  for (Moved& g : sweep.moved) g.shape = geom_shape(m, d, g.geom);
   double step = sweep.planes ? sampled : INFINITY;
   for (const Fixed& o : sweep.obstacles)
     for (const Moved& g : sweep.moved) {

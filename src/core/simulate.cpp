@@ -12,6 +12,7 @@
 #include "leeway/core/box.hpp"
 #include "leeway/core/collision.hpp"
 #include "leeway/core/error.hpp"
+#include "leeway/core/shape.hpp"
 #include "random.hpp"
 
 namespace leeway {
@@ -330,6 +331,7 @@ class ClosedLoop {
   void servo(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::Vector3d& tool);
   void take_box(int g);
   double bound_gap(int g1, int g2) const;
+  double geom_distance(int g1, int g2) const;
 
   const Scene& scene_;
   const BoundsTrajectory& bounds_;
@@ -683,6 +685,13 @@ void ClosedLoop::take_box(int g) {
   box_bounds_[static_cast<size_t>(g)] = {b.center - extent, b.center + extent};
 }
 
+// The distance of two geoms as MuJoCo collides them (shape.hpp): their boxes' for two boxes.
+double ClosedLoop::geom_distance(int g1, int g2) const {
+  if (model_->geom_type[g1] == mjGEOM_BOX && model_->geom_type[g2] == mjGEOM_BOX)
+    return box_distance(boxes_[static_cast<size_t>(g1)], boxes_[static_cast<size_t>(g2)]);
+  return shape_distance(geom_shape(*model_, *data_, g1), geom_shape(*model_, *data_, g2));
+}
+
 // A lower bound of the distance between two geoms' boxes: the gap between their bounding boxes.
 double ClosedLoop::bound_gap(int g1, int g2) const {
   const Aabb& a = box_bounds_[static_cast<size_t>(g1)];
@@ -728,7 +737,7 @@ void ClosedLoop::measure_distances(double t) {
     if (geoms_touch(m, d, p.geom1, p.geom2))
       touch(p.geom1, p.geom2, box_penetration(box(p.geom1), box(p.geom2)), true);
     else if (bound_gap(p.geom1, p.geom2) <= reach())
-      near(p.geom1, p.geom2, box_distance(box(p.geom1), box(p.geom2)));
+      near(p.geom1, p.geom2, geom_distance(p.geom1, p.geom2));
   }
   const StaticGeoms& statics = scene_.statics();
   for (int l : scene_.link_geoms()) {
@@ -738,7 +747,7 @@ void ClosedLoop::measure_distances(double t) {
     statics.grid.any(query, [&](int i) {
       const int o = statics.geoms[static_cast<size_t>(i)];
       if (scene_.role(o) == GeomRole::kObstacle && has_bounding_box(m, o) && bound_gap(l, o) <= reach())
-        near(l, o, box_distance(box(l), box(o)));
+        near(l, o, geom_distance(l, o));
       return false;
     });
   }

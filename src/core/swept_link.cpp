@@ -8,6 +8,16 @@
 
 namespace leeway {
 
+SweepObstacle sweep_obstacle(int geom, const Shape& shape) {
+  SweepObstacle o;
+  o.geom = geom;
+  o.shape = shape;
+  o.box = shape.box;
+  o.plane = shape.plane();
+  o.radius = o.plane ? INFINITY : shape.radius;
+  return o;
+}
+
 bool touches(const Box& box, double grow, const Box& obstacle, bool plane) {
   Box grown = box;
   grown.half_size.array() += grow;
@@ -36,8 +46,10 @@ void SweptLink::start(const LinkChain& link, int link_id, const Eigen::VectorXd&
     box_.rotation =
         link.translate_only ? Eigen::Matrix3d::Identity() : Eigen::Matrix3d(frame * link.local_rot);
     box_.half_size = link.half_size;
+    shape_ = box_shape(box_);
   } else {
-    box_ = geom_box(m, d, link.geom);
+    shape_ = geom_shape(m, d, link.geom);
+    box_ = shape_.box;
   }
   hl_ = *hv;
   for (int p = 0; p < held; ++p) hl_[link.joints[static_cast<size_t>(p)]] = 0;
@@ -191,6 +203,11 @@ double SweptLink::box_extent(const Eigen::Vector3d& n) const {
   return (box_.rotation.transpose() * n).cwiseAbs().dot(box_.half_size);
 }
 
+double SweptLink::extent(const Eigen::Vector3d& n) const {
+  if (!shaped()) return box_extent(n);
+  return shape_.support(n) - n.dot(box_.center);
+}
+
 double SweptLink::remainder_cheap(const Eigen::Vector3d& n) const {
   const double half_sum = box_.half_size.sum();
   double r = 0;
@@ -230,11 +247,11 @@ Separation separate(SweptLink& link, const SweepObstacle& obs, double margin) {
   out.axis = (obs.box.center - box.center).normalized();
   double best_gap = -std::numeric_limits<double>::infinity();
   // Whether the pair is separated on axis n given the signed distance `apart` between the link's
-  // centre and the obstacle's near face along n, with the obstacle's extent removed. The refined
-  // remainder only where the cheap one fails and the rest leaves room; the gap of an axis (for the
-  // blame and the search order) is its best bound either way.
-  auto separated_on = [&](const Eigen::Vector3d& nrm, double apart) {
-    const double base = apart - link.motion_extent(nrm) - link.box_extent(nrm);
+  // centre and the obstacle's near face along n, with the obstacle's extent removed, and the link's
+  // own extent toward it. The refined remainder only where the cheap one fails and the rest leaves
+  // room; the gap of an axis (for the blame and the search order) is its best bound either way.
+  auto separated_on = [&](const Eigen::Vector3d& nrm, double apart, double extent) {
+    const double base = apart - link.motion_extent(nrm) - extent;
     double g = base - link.remainder_cheap(nrm);
     bool sep = g > margin;
     if (!sep && base > margin) {
@@ -247,21 +264,32 @@ Separation separate(SweptLink& link, const SweepObstacle& obs, double margin) {
     }
     return sep;
   };
+  const bool boxes = obs.shape.is_box() && !link.shaped();
   const Eigen::Vector3d diff = obs.box.center - box.center;
   if (!obs.plane && diff.norm() - link.radius() - obs.radius > margin) {
     out.separated = true;
   } else if (obs.plane) {
     const Eigen::Vector3d nrm = obs.box.rotation.col(2);
-    out.separated = separated_on(nrm, nrm.dot(box.center - obs.box.center));
+    out.separated = separated_on(nrm, nrm.dot(box.center - obs.box.center), link.extent(-nrm));
   } else {
+    // On unit axis n, the side (n or -n) where the two projections are further apart: the link's
+    // extent toward the obstacle and the obstacle's support toward the link (exact for both).
     auto try_axis = [&](const Eigen::Vector3d& candidate) {
       const double len = candidate.norm();
       if (len < 1e-9) return false;
       const Eigen::Vector3d nrm = candidate / len;
-      const double ro = (obs.box.rotation.transpose() * nrm).cwiseAbs().dot(obs.box.half_size);
-      return separated_on(nrm, std::abs(nrm.dot(diff)) - ro);
+      if (boxes) {
+        const double ro = (obs.box.rotation.transpose() * nrm).cwiseAbs().dot(obs.box.half_size);
+        return separated_on(nrm, std::abs(nrm.dot(diff)) - ro, link.box_extent(nrm));
+      }
+      const double p = nrm.dot(box.center);
+      const double ahead = -obs.shape.support(-nrm) - p, behind = p - obs.shape.support(nrm);
+      const double e_ahead = link.extent(nrm), e_behind = link.extent(-nrm);
+      return ahead - e_ahead >= behind - e_behind ? separated_on(nrm, ahead, e_ahead)
+                                                  : separated_on(-nrm, behind, e_behind);
     };
     bool sep = false;
+    if (!boxes) sep = try_axis(convex_distance(link.shape(), obs.shape, 1e-6).axis);
     for (int k = 0; k < 3 && !sep; ++k) sep = try_axis(obs.box.rotation.col(k));
     for (int k = 0; k < 3 && !sep; ++k) sep = try_axis(box.rotation.col(k));
     for (int k = 0; k < 3 && !sep; ++k)

@@ -10,6 +10,7 @@
 
 #include "leeway/core/collision.hpp"
 #include "leeway/core/error.hpp"
+#include "leeway/core/shape.hpp"
 
 namespace leeway {
 namespace {
@@ -150,8 +151,8 @@ namespace {
 
 // The volume model's MJCF: the robot's link geoms (their types and sizes; poses are written per
 // check) on one free body, and a static body holding `pool` template box geoms. Built from the
-// scene's compiled model, so it needs neither the cell's file nor its includes. A mesh or height
-// field link is represented by its bounding box (geom_box).
+// scene's compiled model, so it needs neither the cell's file nor its includes. A mesh link is the
+// box about its geom's origin that holds its hull, a height field link the cube of its bounding sphere.
 std::string pool_xml(const Scene& scene, int pool) {
   const mjModel& m = scene.model();
   std::ostringstream x;
@@ -177,7 +178,13 @@ std::string pool_xml(const Scene& scene, int pool) {
       case mjGEOM_BOX:
         x << "type=\"box\" size=\"" << size[0] << " " << size[1] << " " << size[2] << "\"/>";
         break;
-      default: {  // mesh, height field: the bounding box
+      case mjGEOM_MESH: {  // the box about the geom's origin that holds its hull
+        const Eigen::AlignedBox3d b = mesh_local_bounds(m, g);
+        const Eigen::Vector3d h = b.min().cwiseAbs().cwiseMax(b.max().cwiseAbs());
+        x << "type=\"box\" size=\"" << h[0] << " " << h[1] << " " << h[2] << "\"/>";
+        break;
+      }
+      default: {  // height field: the cube of its bounding sphere
         const double r = m.geom_rbound[g] > 0 ? m.geom_rbound[g] : 1.0;
         x << "type=\"box\" size=\"" << r << " " << r << " " << r << "\"/>";
       }

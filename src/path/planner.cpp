@@ -25,6 +25,7 @@
 #include "core/random.hpp"
 #include "leeway/core/box.hpp"
 #include "leeway/core/error.hpp"
+#include "leeway/core/shape.hpp"
 
 namespace leeway {
 namespace {
@@ -65,20 +66,20 @@ Eigen::VectorXd lerp(const Eigen::VectorXd& a, const Eigen::VectorXd& b, long k,
 }
 
 // RobotState::clearance(q).distance >= margin at the configuration last set, but quicker: most
-// link-obstacle pairs are ruled out by two lower bounds of their distance (bounding spheres, then
-// the separating-axis gap) before the exact, iterative box distance is needed.
+// link-obstacle pairs are ruled out by two lower bounds of their distance (bounding spheres, then,
+// for two boxes, the separating-axis gap) before the exact distance of their shapes is needed.
 bool keeps_clearance(const RobotState& state, double margin) {
   const Scene& scene = state.scene();
   const mjModel& m = scene.model();
   const mjData& d = state.data();
   for (int o : scene.obstacle_geoms()) {
     if (m.geom_type[o] == mjGEOM_PLANE) continue;  // as RobotState::clearance
-    const Box ob = geom_box(m, d, o);
+    const Shape ob = geom_shape(m, d, o);
     for (int l : scene.link_geoms()) {
-      const Box lb = geom_box(m, d, l);
-      if ((lb.center - ob.center).norm() - lb.half_size.norm() - ob.half_size.norm() >= margin) continue;
-      if (-box_penetration(lb, ob) >= margin) continue;
-      if (box_distance(lb, ob) < margin) return false;
+      const Shape lb = geom_shape(m, d, l);
+      if ((lb.box.center - ob.box.center).norm() - lb.radius - ob.radius >= margin) continue;
+      if (lb.is_box() && ob.is_box() && -box_penetration(lb.box, ob.box) >= margin) continue;
+      if (shape_distance(lb, ob) < margin) return false;
     }
   }
   return true;

@@ -13,6 +13,7 @@
 
 #include "leeway/core/error.hpp"
 #include "leeway/core/mujoco_util.hpp"
+#include "leeway/core/shape.hpp"
 #include "leeway/viz/render.hpp"
 
 #ifndef LEEWAY_THREE_DIR
@@ -158,21 +159,21 @@ json geoms_json(const Scene& scene, json& meshes, long& drawn) {
 }
 
 // Each link's clearance [m] to the obstacles at q, as RobotState::clearance measures the closest
-// pair (exact box distances; other geoms by their bounding boxes; planes skipped).
-void link_clearances(const Scene& scene, const mjData& d, const std::vector<Box>& obstacles,
+// pair (the shapes as MuJoCo collides them, shape.hpp; planes skipped).
+void link_clearances(const Scene& scene, const mjData& d, const std::vector<Shape>& obstacles,
                      std::vector<float>& out) {
   const mjModel& m = scene.model();
   for (int l : scene.link_geoms()) {
-    const Box link = geom_box(m, d, l);
-    const Eigen::AlignedBox3d around = aligned(link);
+    const Shape link = geom_shape(m, d, l);
+    const Eigen::AlignedBox3d around = aligned(link.box);
     double best = INFINITY;
-    for (const Box& o : obstacles) {
+    for (const Shape& o : obstacles) {
       // The distance between the aligned boxes is a lower bound: skip pairs that cannot be closer.
-      const Eigen::AlignedBox3d ob = aligned(o);
+      const Eigen::AlignedBox3d ob = aligned(o.box);
       const Eigen::Vector3d gap =
           (ob.min() - around.max()).cwiseMax(around.min() - ob.max()).cwiseMax(Eigen::Vector3d::Zero());
       if (gap.norm() >= best) continue;
-      best = std::min(best, box_distance(link, o));
+      best = std::min(best, shape_distance(link, o));
     }
     out.push_back(static_cast<float>(std::isfinite(best) ? best : -1.0));  // -1: no obstacle
   }
@@ -188,9 +189,9 @@ json path_json(const Scene& scene, const BoundsTrajectory& path, const ViewerOpt
   const mjModel& m = scene.model();
   DataPtr d = make_data(m);
   mj_kinematics(&m, d.get());
-  std::vector<Box> obstacles;
+  std::vector<Shape> obstacles;
   for (int o : scene.obstacle_geoms())
-    if (has_bounding_box(m, o)) obstacles.push_back(geom_box(m, *d, o));
+    if (has_bounding_box(m, o)) obstacles.push_back(geom_shape(m, *d, o));
   std::vector<double> t, s, nominal, lower, upper;
   std::vector<float> tool, clearance;
   std::vector<Eigen::VectorXd> framed;

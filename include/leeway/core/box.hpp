@@ -46,8 +46,9 @@ inline Eigen::Matrix3d mat3(const mjtNum* p) {
 }
 
 //! World-frame box of a geom after kinematics: exact for boxes; for other types the box bounds the
-//! geom in its own frame (sphere, capsule, cylinder, ellipsoid), or is the cube of its bounding
-//! sphere (mesh, height field). Planes have no finite box: the returned half-size is infinite.
+//! geom in its own frame (sphere, capsule, cylinder, ellipsoid); a mesh's is the tight box of its
+//! convex hull's vertices (in the geom frame or the world's axes, whichever is smaller: shape.hpp),
+//! a height field's the box of its extent. Planes have no finite box: the half-size is infinite.
 Box geom_box(const mjModel& m, const mjData& d, int geom);
 
 //! The one rule for planes: false for a plane, true for every other geom type. A plane has no

@@ -194,7 +194,8 @@ class Certifier {
   void add_self_pairs();
   void index_pairs();
   //! A self pair's other geom at the leaf's centre, grown by what its own free joints move it.
-  SweepObstacle other_geom_swept(const CertifyContext& ctx, const SelfPair& pair, const Box& at_centre) const;
+  SweepObstacle other_geom_swept(const CertifyContext& ctx, const SelfPair& pair,
+                                 const Shape& at_centre) const;
   //! Fills `failure` for the leaf's first failing pair (the blame: the joint to split).
   void describe_failure(const CertifyContext& ctx, const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
                         const SweepObstacle& obs, bool self, const Separation& sep,

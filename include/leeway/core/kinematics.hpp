@@ -80,8 +80,9 @@ class RobotState {
   std::vector<Contact> contacts(const Eigen::VectorXd& q);
   //! All self pairs in contact at q (deepest first).
   std::vector<SelfContact> self_contacts(const Eigen::VectorXd& q);
-  //! Clearance between robot links and obstacles at q: exact box-to-box distances (non-box geoms
-  //! by their bounding boxes, so a lower bound for them; planes are skipped).
+  //! Clearance between robot links and obstacles at q: the distance of their shapes as MuJoCo
+  //! collides them (shape.hpp: exact for boxes, a lower bound within 1e-9 m for the others; a mesh
+  //! is its convex hull; planes are skipped).
   Clearance clearance(const Eigen::VectorXd& q);
   //! 6 x dof Jacobian of the tool site (rows: linear, then angular) at the last set() q.
   Eigen::MatrixXd tool_jacobian();
@@ -117,7 +118,7 @@ struct IkResult {
 };
 
 //! The self pairs that touch at q, for deciding what to exclude (import-urdf, new-cell): the pairs
-//! of state.self_contacts(q), and the box pairs whose exact distance is at most `tolerance` [m],
+//! of state.self_contacts(q), and the pairs whose distance (shape.hpp) is at most `tolerance` [m],
 //! with depth 0 (boxes meeting face to face at a joint touch or not by rounding; this answers the
 //! same either way). Deepest first.
 std::vector<SelfContact> self_contacts_within(RobotState& state, const Eigen::VectorXd& q, double tolerance);

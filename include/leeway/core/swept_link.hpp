@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "leeway/core/box.hpp"
+#include "leeway/core/shape.hpp"
 
 namespace leeway {
 
@@ -37,13 +38,17 @@ struct LinkChain {
   bool translate_only = false;
 };
 
-//! What a link is tested against: an obstacle's (or another robot geom's) box.
+//! What a link is tested against: an obstacle (or another robot geom) by its real shape.
 struct SweepObstacle {
   int geom = -1;
-  Box box;
+  Shape shape;          //!< the geom as MuJoCo collides it (a box when a self pair's geom is grown)
+  Box box;              //!< the box that holds it (shape.box)
   bool plane = false;   //!< a half-space (normal = box z axis, surface through the centre)
-  double radius = 0.0;  //!< bounding-sphere radius of the box (infinite for planes)
+  double radius = 0.0;  //!< radius of a ball about box.center that holds it (infinite for planes)
 };
+
+//! An obstacle of the certificate from a geom's shape.
+SweepObstacle sweep_obstacle(int geom, const Shape& shape);
 
 //! True when `box` grown by `grow` [m] on every side touches or overlaps the obstacle: a box by the
 //! separating-axis test, a plane as the half-space below its surface (normal = its z axis).
@@ -63,8 +68,15 @@ class SweptLink {
   //! pivot box, its entries from frozen_from on).
   void start(const LinkChain& link, int link_id, const Eigen::VectorXd& h, int held, const mjModel& m,
              const mjData& d);
-  //! The link's box at the centre.
+  //! The link's box at the centre (it holds the link's shape; a pivot box is its own shape).
   const Box& box() const { return box_; }
+  //! The link's shape at the centre: its geom's, or its box for a pivot box.
+  const Shape& shape() const { return shape_; }
+  //! True when the shape is not its box (a round or mesh link): extent() then uses the shape.
+  bool shaped() const { return !shape_.is_box(); }
+  //! How far the link's shape at the centre reaches along the unit axis n beyond its box's centre,
+  //! max over its points y of n . (y - box().center) [m]: box_extent(n) for a box.
+  double extent(const Eigen::Vector3d& n) const;
   //! Radius of a sphere about the box's centre that holds the swept link (no Jacobian) [m].
   double cheap_radius() const { return iso_cheap_; }
   //! Builds the Jacobian-based bound (once per start()).
@@ -108,6 +120,7 @@ class SweptLink {
   const mjData* d_ = nullptr;
   int held_ = 0;
   Box box_;
+  Shape shape_;
   Eigen::VectorXd hl_;
   bool built_ = false, terms_built_ = false;
   std::vector<Eigen::Vector3d> jac_;       // d x / d q_p at c
@@ -139,7 +152,9 @@ struct Separation {
 
 //! Whether the swept link (built) stays more than `margin` from the obstacle: the sphere of
 //! radius(), then the candidate axes (the obstacle's 3 face normals, the link box's 3, their 9
-//! cross products, the centre line; a plane's normal only). `gap` is the best axis's clearance
+//! cross products, the centre line; a plane's normal only). When the link or the obstacle is not a
+//! box, each side's projection is its shape's support, and the axis of the two shapes' closest
+//! points at the centre (GJK) is tried first. `gap` is the best axis's clearance
 //! under the bound, margin not subtracted (-infinity when no axis was tried).
 Separation separate(SweptLink& link, const SweepObstacle& obstacle, double margin);
 

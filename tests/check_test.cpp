@@ -11,6 +11,7 @@
 #include "leeway/core/box.hpp"
 #include "leeway/core/kinematics.hpp"
 
+#include "stl_util.hpp"
 #include "test_util.hpp"
 
 namespace leeway {
@@ -152,12 +153,42 @@ TEST_F(CheckTest, OverlappingObstacles) {
 }
 
 TEST_F(CheckTest, UnnamedObstacleAndNonBoxObstacle) {
+  // A sphere is checked by its real shape: no warning.
   const auto r = run(R"(<geom type="box" size="0.1 0.1 0.1" pos="3 3 0.1"/>
     <geom name="ball" type="sphere" size="0.1" pos="-3 3 0.1"/>)");
   EXPECT_TRUE(has_problem(r, "unnamed geom"));
-  bool warned = false;
-  for (const auto& w : r.warnings) warned |= w.find("obstacle ball is not a box") != std::string::npos;
-  EXPECT_TRUE(warned) << ::testing::PrintToString(r.warnings);
+  for (const auto& w : r.warnings) EXPECT_EQ(w.find("ball"), std::string::npos) << w;
+}
+
+// An L-shaped mesh (two closed boxes, [0, 1] x [0, 0.2] and [0, 0.2] x [0.2, 1], 0.1 m thick): the
+// mesh holds 0.036 m^3 and its hull, over the pentagon (0, 0), (1, 0), (1, 0.2), (0.2, 1), (0, 1)
+// of area 0.68 m^2, 0.068 m^3, so the hull fills in 0.032 m^3 (47.1 % of it). A box mesh: 0 %.
+TEST_F(CheckTest, MeshObstacleReportsWhatItsHullFillsIn) {
+  test::write_binary_stl((dir_.path() / "ell.stl").string(), [] {
+    auto a = test::cuboid(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0.2, 0.1));
+    const auto b = test::cuboid(Eigen::Vector3d(0, 0.2, 0), Eigen::Vector3d(0.2, 1, 0.1));
+    a.insert(a.end(), b.begin(), b.end());
+    return a;
+  }());
+  test::write_binary_stl((dir_.path() / "brick.stl").string(),
+                         test::cuboid(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.3, 0.2, 0.1)));
+  std::string xml = one_link_cell(R"(<geom name="ell" type="mesh" mesh="ell" pos="2 2 0"/>
+    <geom name="brick" type="mesh" mesh="brick" pos="-2 2 0"/>)");
+  xml.replace(
+      xml.find("<worldbody>"), 11,
+      R"(<asset><mesh name="ell" file="ell.stl"/><mesh name="brick" file="brick.stl"/></asset><worldbody>)");
+  scene_ = std::make_unique<Scene>(Scene::load(dir_.write("cell.xml", xml)));
+  const CheckReport r = check_scene(*scene_);
+  std::vector<std::string> about_ell, about_brick;
+  for (const auto& w : r.warnings) {
+    if (w.find("obstacle ell is a mesh") != std::string::npos) about_ell.push_back(w);
+    if (w.find("brick") != std::string::npos) about_brick.push_back(w);
+  }
+  ASSERT_EQ(about_ell.size(), 1u) << ::testing::PrintToString(r.warnings);
+  EXPECT_NE(about_ell[0].find("fills in 0.032 m^3 beyond the mesh (47.1 % of the hull"), std::string::npos)
+      << about_ell[0];
+  EXPECT_NE(about_ell[0].find("leeway import-mesh"), std::string::npos);
+  EXPECT_TRUE(about_brick.empty()) << ::testing::PrintToString(about_brick);
 }
 
 TEST_F(CheckTest, JsonHasTheDocumentedFields) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -308,6 +309,23 @@ TEST_F(CliBoundsTest, HelpOnTheNewSubcommands) {
     EXPECT_EQ(r.exit_code, 0) << sub;
     EXPECT_THAT(r.out, HasSubstr("--help")) << sub;
   }
+}
+
+// A path whose end comes 0.5 mm from a wall cannot be certified with the 1 mm margin: `bounds` names
+// the pair, where along the segment and how far apart the two are there. The one-link arm's tip
+// corner reaches the wall's face y = 0.5 at sin(t) + 0.05 cos(t) = 0.5 - c, i.e. t = asin((0.5 - c)
+// / sqrt(1.0025)) - atan(0.05); c = 0.5 mm there.
+TEST_F(CliBoundsTest, BoundsNamesThePairThatStopsTheProof) {
+  const double end = std::asin(0.4995 / std::sqrt(1.0025)) - std::atan(0.05);
+  const std::string cell = dir_.write(
+      "cell.xml", test::one_link_cell(
+                      R"(<geom name="wall" type="box" size="0.6 0.1 0.5" pos="0.6 0.6 0.5"/>)",
+                      R"(<key name="a" qpos="0"/><key name="b" qpos=")" + std::to_string(end) + R"("/>)"));
+  const auto r = run_cli("bounds " + cell + " --from a --to b --no-plan");
+  EXPECT_THAT(r.out,
+              HasSubstr("segment 0 (waypoints 0-1) not certified: link link_box and obstacle wall at t = "));
+  EXPECT_THAT(r.out, HasSubstr(" m apart on the nominal path there"));
+  EXPECT_THAT(r.out, ::testing::Not(HasSubstr("exclude the pair")));
 }
 
 }  // namespace

@@ -72,6 +72,25 @@ void print_room(const Scene& scene, const RoomReport& room, const RoomOptions& o
   std::cout << o.str() << "\n";
 }
 
+// Per segment that could not be certified: the pair that stopped the proof, where, and how far apart
+// the two geoms are on the nominal path there, with a hint for a robot pair.
+void print_blocked(const Scene& scene, const SafetyReport& r) {
+  for (size_t k = 0; k < r.segments.size(); ++k) {
+    const SegmentSafety& s = r.segments[k];
+    if (s.passed || s.blocking_link < 0) continue;
+    std::cout << "safety: segment " << k << " (waypoints " << k << "-" << k + 1
+              << ") not certified: " << (s.blocking_self ? "robot geoms " : "link ")
+              << scene.geom_label(s.blocking_link) << (s.blocking_self ? " and " : " and obstacle ")
+              << scene.geom_label(s.blocking_other) << " at t = " << format_number(s.blocking_t)
+              << " of the segment, " << format_number(s.blocking_distance)
+              << " m apart on the nominal path there";
+    if (s.blocking_self)
+      std::cout << " (a robot pair: if the two geoms only touch where the real links do not, exclude "
+                   "the pair in the cell, docs/mjcf-conventions.md \"Self-collision\")";
+    std::cout << "\n";
+  }
+}
+
 // One line on the safety stage: mode, outcome, work.
 void print_safety(const SafetyReport& r, const SafetyParams& params) {
   int passed = 0;
@@ -252,6 +271,7 @@ int run_bounds(const BoundsArgs& args) {
                 << shrink_note(run.bounds[w], i) << "\n";
   }
   print_safety(run.safety, p.safety);
+  print_blocked(scene, run.safety);
   if (room) print_room(scene, *room, room_options);
   std::cout << std::setprecision(1) << "time [ms]: categorize " << run.ms_categorize << ", volume "
             << run.ms_volume << ", inject " << run.ms_inject << ", bounds " << run.ms_bounds << ", safety "

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
+#include <utility>
 
 #include "json_io.hpp"
 #include "leeway/core/categorize.hpp"
@@ -12,6 +14,9 @@
 
 namespace leeway {
 namespace {
+
+// A mesh obstacle whose convex hull exceeds the mesh by more than this share of the hull is reported.
+constexpr double kHullExcessWarning = 0.01;
 
 std::string vec3(const Eigen::Vector3d& v) {
   return "(" + format_number(v.x()) + ", " + format_number(v.y()) + ", " + format_number(v.z()) + ")";
@@ -42,6 +47,38 @@ double penetration(const mjModel& m, const mjData& d, int g1, int g2) {
 
 bool is_box(const mjModel& m, int g) { return m.geom_type[g] == mjGEOM_BOX; }
 
+// The volume [m^3] enclosed by triangles (three vertex indices each into `vertices`, 3 floats per
+// vertex) by the divergence theorem: exact for a closed surface.
+double enclosed_volume(const float* vertices, const int* faces, int count) {
+  double six = 0;
+  for (int f = 0; f < count; ++f) {
+    Eigen::Vector3d v[3];
+    for (int k = 0; k < 3; ++k) {
+      const float* p = vertices + 3 * faces[3 * f + k];
+      v[k] = Eigen::Vector3d(p[0], p[1], p[2]);
+    }
+    six += v[0].dot(v[1].cross(v[2]));
+  }
+  return std::abs(six) / 6;
+}
+
+// A mesh obstacle's convex hull (what MuJoCo collides) against the mesh itself: the volume the hull
+// fills in beyond the mesh [m^3] and its share of the hull, when MuJoCo computed the hull.
+std::optional<std::pair<double, double>> hull_excess(const mjModel& m, int g) {
+  const int mesh = m.geom_dataid[g];
+  const int graph = m.mesh_graphadr[mesh];
+  if (graph < 0) return std::nullopt;
+  const int numvert = m.mesh_graph[graph], numface = m.mesh_graph[graph + 1];
+  const float* vertices = m.mesh_vert + 3 * m.mesh_vertadr[mesh];
+  const double hull =
+      enclosed_volume(vertices, m.mesh_graph + graph + 2 + 3 * numvert + 3 * numface, numface);
+  const double solid =
+      enclosed_volume(vertices, m.mesh_face + 3 * m.mesh_faceadr[mesh], m.mesh_facenum[mesh]);
+  if (!(hull > 0)) return std::nullopt;
+  const double excess = std::max(0.0, hull - solid);
+  return std::make_pair(excess, excess / hull);
+}
+
 }  // namespace
 
 std::vector<Box> obstacle_boxes(const Scene& scene) {
@@ -68,9 +105,16 @@ void check_obstacles(const Scene& scene, const mjData& rest, const CheckOptions&
     if (m.geom_type[g] == mjGEOM_PLANE)
       report.problems.push_back("obstacle " + scene.geom_label(g) +
                                 " is a collidable plane: give the floor contype=\"0\" conaffinity=\"0\"");
-    else if (!is_box(m, g))
-      report.warnings.push_back("obstacle " + scene.geom_label(g) +
-                                " is not a box: the volume uses its bounding box");
+    else if (m.geom_type[g] == mjGEOM_MESH)
+      if (const auto excess = hull_excess(m, g); excess && excess->second > kHullExcessWarning)
+        report.warnings.push_back(
+            "obstacle " + scene.geom_label(g) +
+            " is a mesh: MuJoCo and leeway collide its convex hull, which "
+            "fills in " +
+            format_number(excess->first) + " m^3 beyond the mesh (" +
+            format_number(std::round(excess->second * 1000) / 10) +
+            " % of the hull; room in its openings is lost): split it into convex pieces with leeway "
+            "import-mesh (docs/mjcf-conventions.md, \"CAD meshes\")");
   }
   auto add_overlap = [&](int a, int b, const char* what) {
     const double depth = penetration(m, rest, a, b);

@@ -9,6 +9,7 @@
 #include "grow.hpp"
 #include "leeway/core/error.hpp"
 #include "leeway/core/kinematics.hpp"
+#include "leeway/core/shape.hpp"
 #include "parallel.hpp"
 #include "random.hpp"
 
@@ -251,8 +252,9 @@ class SegmentRepair {
       s_.passed = s_.run = true;
       return;
     }
+    CertifyFailure f;
     while (s_.shrink_steps < kMaxShrinkSteps) {
-      CertifyFailure f;
+      f = CertifyFailure{};
       if (probed(a_, b_, &f) && certified(a_, b_, &f)) {
         s_.passed = true;
         break;
@@ -265,11 +267,27 @@ class SegmentRepair {
       ++s_.shrink_steps;
       if (!shrink_for(f)) break;  // nothing left to shrink: the nominal segment itself is not certified
     }
-    if (!s_.passed)
+    if (!s_.passed) {
       for (size_t k : {a_, b_}) {
         e_.below[k].setZero();
         e_.above[k].setZero();
       }
+      describe_block(f);
+    }
+  }
+
+  // What stopped the proof of this segment: the failing pair, where, and its distance there.
+  void describe_block(const CertifyFailure& f) {
+    if (f.link_geom < 0 || f.obstacle_geom < 0) return;
+    s_.blocking_link = f.link_geom;
+    s_.blocking_other = f.obstacle_geom;
+    s_.blocking_self = f.self;
+    s_.blocking_t = a_ == b_ ? 0.0 : (f.t0 + f.t1) / 2;
+    RobotState state(ctx_.scene());
+    state.set((1 - s_.blocking_t) * e_.q[a_] + s_.blocking_t * e_.q[b_]);
+    const mjModel& m = ctx_.scene().model();
+    s_.blocking_distance = shape_distance(geom_shape(m, state.data(), f.link_geom),
+                                          geom_shape(m, state.data(), f.obstacle_geom));
   }
 
   // Halves the blamed joint's extent on its side (`above`), or with joint < 0 every extent, at the

@@ -31,6 +31,14 @@ struct SegmentSafety {
   //! one proof of a box holding this and the next segments), its own or an earlier segment's.
   bool run = false;
   long run_leaves = 0;  //!< leaves this segment spent on run boxes, proven or not (in `leaves` too)
+  //! Certified mode, not passed: the pair that stopped the last proof (a link geom and an obstacle,
+  //! or another robot geom when `blocking_self`; -1 when the budget ran out before any pair failed),
+  //! where along the segment (t in [0, 1], from waypoint a to b) and the distance of the two geoms'
+  //! shapes at the nominal configuration there [m] (0 in contact).
+  int blocking_link = -1, blocking_other = -1;
+  bool blocking_self = false;
+  double blocking_t = 0.0;
+  double blocking_distance = 0.0;
 };
 
 //! The certified mode's work limit per segment, in multiples of SafetyParams::max_leaves: every

@@ -30,6 +30,9 @@ using Eigen::Vector3d;
 // MuJoCo 2.2.2 refuses a mesh whose volume is below about 1e-15 m^3 ("mesh volume is too small");
 // pieces are kept a hundred times above that.
 constexpr double kMinVolume = 1e-13;
+// Merged pieces may touch other pieces but overlap none deeper than this [m] (a tenth of leeway
+// check's overlap tolerance).
+constexpr double kOverlapDepth = 1e-5;
 
 // ---- The part: distance to its surface (a bounding-volume tree) and, when closed, inside tests.
 
@@ -384,24 +387,36 @@ std::optional<std::pair<Cell, Cell>> split_cell(const Cell& cell, const PartSoli
     for (const auto& d : directions) known = known || std::abs(d.dot(axes.col(k))) > 0.999;
     if (!known) directions.push_back(axes.col(k));
   }
-  std::optional<Plane> best;
+  std::vector<std::pair<Plane, double>> scored;  // each plane with its halves' hull volumes
   double best_score = std::numeric_limits<double>::infinity();
+  auto halves = [&](const Plane& plane) {
+    std::vector<Face> plus, minus;
+    for (const auto& f : cell.faces) split_face(f, plane, eps, plus, minus);
+    // Without the new corners (they need inside tests; the chosen split adds them).
+    return std::make_pair(Cell{std::move(plus), {}, {}}, Cell{std::move(minus), {}, {}});
+  };
   for (const auto& u : directions) {
     std::vector<double> along;
     for (const auto& p : points) along.push_back(u.dot(p));
     for (const double offset : candidate_offsets(along, 1e3 * eps)) {
-      const Plane plane{u, offset};
-      std::vector<Face> plus, minus;
-      for (const auto& f : cell.faces) split_face(f, plane, eps, plus, minus);
-      if (plus.empty() || minus.empty()) continue;
-      // Scored without the new corners (they need inside tests; the chosen split adds them).
-      Cell a{std::move(plus), {}, {}}, b{std::move(minus), {}, {}};
+      const auto [a, b] = halves(Plane{u, offset});
+      if (a.faces.empty() || b.faces.empty()) continue;
       const double score = convex_hull(a.points()).volume + convex_hull(b.points()).volume;
-      if (score < best_score) {
-        best_score = score;
-        best = plane;
-      }
+      scored.emplace_back(Plane{u, offset}, score);
+      best_score = std::min(best_score, score);
     }
+  }
+  // Planes of the same volumes (common in axis-aligned parts: any cut of a table between its legs
+  // leaves the same two boxes) are told apart by their halves' excesses, on a few samples.
+  std::optional<Plane> best;
+  double best_excess = std::numeric_limits<double>::infinity();
+  for (const auto& [plane, score] : scored) {
+    if (score > best_score * (1 + 1e-9) + 1e-15) continue;
+    const auto [a, b] = halves(plane);
+    std::mt19937_64 rng(1);
+    const double excess = measure_excess(convex_hull(a.points()), solid, 64, rng) +
+                          measure_excess(convex_hull(b.points()), solid, 64, rng);
+    if (excess < best_excess) std::tie(best_excess, best) = std::make_pair(excess, plane);
   }
   if (!best) return std::nullopt;
   std::vector<Face> plus, minus;
@@ -448,9 +463,24 @@ double box_gap(const std::vector<Vector3d>& a, const std::vector<Vector3d>& b) {
   return (alo - bhi).cwiseMax(blo - ahi).cwiseMax(0).norm();
 }
 
-// Merges pairs of pieces whose joint hull stays within the tolerance, the least added hull volume
-// first: a cut chosen for one piece can leave a flat part (a table's top) in strips. Pairs whose
-// boxes lie more than the tolerance apart are not tried; each pair is measured once.
+// Two hulls overlap by more than `depth`: no facet normal of either separates them to within it (a
+// conservative test: edge-edge axes are not tried, so a near miss may count as an overlap).
+bool hulls_overlap(const Hull& a, const Hull& b, double depth) {
+  auto separated = [depth](const Hull& h, const Hull& other) {
+    for (const auto& plane : h.planes) {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const auto& v : other.vertices) nearest = std::min(nearest, plane.head<3>().dot(v) + plane[3]);
+      if (nearest >= -depth) return true;
+    }
+    return false;
+  };
+  return !separated(a, b) && !separated(b, a);
+}
+
+// Merges pairs of pieces whose joint hull stays within the tolerance and overlaps no other piece
+// (leeway check reports obstacles overlapping by more than 1e-4 m), the least added hull volume
+// first: a cut chosen for one piece can leave a flat part in strips. Pairs whose boxes lie more than
+// the tolerance apart are not tried; each pair is measured once.
 void merge_pieces(std::vector<Measured>& pieces, double tolerance,
                   const std::function<Measured(const std::vector<Vector3d>&)>& measure) {
   std::vector<int> ids(pieces.size());
@@ -472,7 +502,10 @@ void merge_pieces(std::vector<Measured>& pieces, double tolerance,
             std::vector<Vector3d> points = a;
             points.insert(points.end(), b.begin(), b.end());
             merged = measure(points);
-            if (merged->excess > tolerance) merged.reset();
+            for (size_t k = 0; merged && k < pieces.size(); ++k)
+              if (k != i && k != j && hulls_overlap(merged->hull, pieces[k].hull, kOverlapDepth))
+                merged.reset();
+            if (merged && merged->excess > tolerance) merged.reset();
           }
           it = tried.emplace(key, std::move(merged)).first;
         }

@@ -78,7 +78,8 @@ std::string header(const std::string& path, const std::string& format, const Mes
   text += detail::wrapped_comment(
       "method: recursive hull split (docs/mjcf-conventions.md, \"CAD meshes\"): the part's hull is cut by "
       "the plane along the coordinate or principal axes that minimises the two halves' hull volumes, "
-      "until every piece's hull lies within the tolerance of the part; excess = the largest distance "
+      "until every piece's hull lies within the tolerance of the part, then pieces are merged while "
+      "their joint hull stays within it and overlaps no other piece; excess = the largest distance "
       "from the hull's vertices and " +
           std::to_string(o.samples) + " points sampled on and in it (seed " + std::to_string(o.seed) +
           ") to the part's solid; pieces thinner than tolerance / 10 are thickened to it.",

@@ -16,6 +16,7 @@
 #include "cli/common.hpp"
 #include "cli/fk.hpp"
 #include "cli/ik.hpp"
+#include "cli/import_mesh.hpp"
 #include "cli/import_urdf.hpp"
 #include "cli/new_cell.hpp"
 #include "cli/params.hpp"
@@ -50,6 +51,7 @@ int main(int argc, char** argv) {
   SweepArgs sweep;
   ParamsArgs params;
   ImportUrdfArgs import_urdf;
+  ImportMeshArgs import_mesh;
   NewCellArgs new_cell;
   RenderArgs render;
   ViewArgs view;
@@ -69,6 +71,7 @@ int main(int argc, char** argv) {
       {add_sweep(app, sweep), [&] { return run_sweep(sweep); }},
       {add_params(app, params), [&] { return run_params(params); }},
       {add_import_urdf(app, import_urdf), [&] { return run_import_urdf(import_urdf); }},
+      {add_import_mesh(app, import_mesh), [&] { return run_import_mesh(import_mesh); }},
       {add_new_cell(app, new_cell), [&] { return run_new_cell(new_cell); }},
       {add_render(app, render), [&] { return run_render(render); }},
       {add_view(app, view), [&] { return run_view(view); }},

@@ -446,5 +446,36 @@ TEST(ClosedPipe, StandardOutputClosedIsExitTwo) {
   }
 }
 
+// A cell's <option> must not blind the checks: with contacts or constraints disabled, an override
+// margin of -0.1 m or predefined pairs only, MuJoCo would report no contact for a keyframe whose
+// link lies 20 cm inside a table. leeway resets those options in its model: the keyframe collides,
+// `check` fails on it and says which option it overrode, and RobotState::in_collision (what the path
+// check, the planner, CF and the sampled mode ask) sees the contact.
+TEST(CellOptions, NoOptionBlindsTheChecks) {
+  const char* options[] = {
+      R"(<option><flag contact="disable"/></option>)",
+      R"(<option><flag constraint="disable"/></option>)",
+      R"(<option o_margin="-0.1"><flag override="enable"/></option>)",
+      R"(<option collision="predefined"/>)",
+  };
+  for (const char* option : options) {
+    SCOPED_TRACE(option);
+    test::TempDir dir;
+    // The link (z 0.45 .. 0.55) at j1 = 1.57 lies over y 0 .. 1; the table's top is at z = 0.65.
+    std::string xml =
+        test::one_link_cell(R"(<geom name="table" type="box" size="0.3 0.3 0.325" pos="0 0.6 0.325"/>)",
+                            R"(<key name="home" qpos="0"/><key name="low" qpos="1.57"/>)");
+    xml.replace(xml.find("<worldbody>"), 11, std::string(option) + "<worldbody>");
+    const Scene scene = Scene::load(dir.write("cell.xml", xml));
+    ASSERT_EQ(scene.overridden_options().size(), 1u);
+    RobotState state(scene);
+    EXPECT_TRUE(state.in_collision(Eigen::VectorXd::Constant(1, 1.57)));
+    EXPECT_FALSE(state.in_collision(Eigen::VectorXd::Constant(1, 0.0)));
+    const auto check = test::run_cli("check " + dir.path().string() + "/cell.xml");
+    EXPECT_EQ(check.exit_code, 1) << check.out;
+    EXPECT_NE(check.out.find("the cell's option"), std::string::npos) << check.out;
+  }
+}
+
 }  // namespace
 }  // namespace leeway

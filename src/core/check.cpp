@@ -255,6 +255,8 @@ CheckReport check_scene(const Scene& scene, const CheckOptions& options) {
   apply_cell_defaults(scene, cell_params);
   validate_for_scene(cell_params, scene);
   CheckReport report;
+  for (const std::string& option : scene.overridden_options())
+    report.warnings.push_back("the cell's option " + option);
   RobotState state(scene);
   const mjModel& m = scene.model();
   DataPtr rest = make_data(m);  // the cell at rest: obstacles and sites where the model puts them

@@ -241,6 +241,7 @@ void Scene::recognise(const SceneOptions& options) {
                      "(contype or conaffinity must be non-zero)");
 
   find_self_pairs();
+  override_blinding_options(m);
 
   // Sites: the tool site in the robot, goal sites outside it.
   // A model the midphase cannot answer for (explicit pairs, excludes, ...) is checked by MuJoCo's
@@ -296,6 +297,26 @@ void Scene::recognise(const SceneOptions& options) {
   for (int g = 0; g < m.ngeom; ++g)
     if (roles_[static_cast<size_t>(g)] != GeomRole::kLink) statics.push_back(g);
   statics_.build(m, *d, statics);
+}
+
+// A cell's <option> can switch MuJoCo's contacts off or shift them, and then every check would call
+// a colliding configuration free. leeway's checks are the geoms' own contacts with their own
+// margins, so those settings are reset in the scene's model, each said in overridden_options().
+void Scene::override_blinding_options(mjModel& m) {
+  if (m.opt.disableflags & mjDSBL_CONTACT)
+    overridden_options_.push_back("<flag contact=\"disable\"/>: leeway checks contacts anyway");
+  if (m.opt.disableflags & mjDSBL_CONSTRAINT)
+    overridden_options_.push_back("<flag constraint=\"disable\"/>: leeway checks contacts anyway");
+  if (m.opt.enableflags & mjENBL_OVERRIDE)
+    overridden_options_.push_back("<flag override=\"enable\"/> (o_margin " + format_number(m.opt.o_margin) +
+                                  " m): leeway uses each geom's own margin");
+  if (m.opt.collision != mjCOL_ALL)
+    overridden_options_.push_back(std::string("collision=\"") +
+                                  (m.opt.collision == mjCOL_PAIR ? "predefined" : "dynamic") +
+                                  "\": leeway checks every pair of geoms its rules make collidable");
+  m.opt.disableflags &= ~(mjDSBL_CONTACT | mjDSBL_CONSTRAINT);
+  m.opt.enableflags &= ~mjENBL_OVERRIDE;
+  m.opt.collision = mjCOL_ALL;
 }
 
 void Scene::find_self_pairs() {

@@ -96,6 +96,10 @@ class Scene {
   //! The robot geom pairs checked for self-collision (RobotPair), and those the cell excludes.
   const std::vector<RobotPair>& self_pairs() const { return self_pairs_; }
   const std::vector<ExcludedPair>& excluded_pairs() const { return excluded_pairs_; }
+  //! The cell's `<option>` settings leeway overrode for its checks, one sentence each (contacts or
+  //! constraints disabled, an override margin, predefined pairs only): every check (check, the
+  //! path check, the planner, IK, CF, the sampled mode, simulate) sees the geoms' own contacts.
+  const std::vector<std::string>& overridden_options() const { return overridden_options_; }
   GeomRole role(int geom) const { return roles_.at(static_cast<size_t>(geom)); }
   //! The geom's name, or "unnamed geom #id on body 'b'" when it has none.
   std::string geom_label(int geom) const;
@@ -128,6 +132,7 @@ class Scene {
   Scene() = default;
   void recognise(const SceneOptions& options);
   void find_self_pairs();
+  void override_blinding_options(mjModel& m);
 
   std::string source_;
   ModelPtr model_;
@@ -138,6 +143,7 @@ class Scene {
   std::vector<int> link_geoms_, base_geoms_, obstacle_geoms_;
   std::vector<RobotPair> self_pairs_;
   std::vector<ExcludedPair> excluded_pairs_;
+  std::vector<std::string> overridden_options_;
   int tool_site_ = -1;
   CollisionChecker checker_ = CollisionChecker::kMidphase;
   StaticGeoms statics_;

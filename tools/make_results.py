@@ -142,6 +142,10 @@ def main():
         shape = ROOT / "docs" / "data" / "room" / name
         if shape.exists():
             o.append(shape.read_text())
+    # Real geometry (meshes, round shapes) against boxes: tools/make_mesh_results.py --write writes it.
+    mesh = ROOT / "docs" / "data" / "mesh" / "section.md"
+    if mesh.exists():
+        o.append(mesh.read_text())
     # The closed loop: tools/make_simulate_results.py writes this section.
     simulate = ROOT / "docs" / "data" / "simulate" / "section.md"
     if simulate.exists():

@@ -2,7 +2,9 @@
 # Derives the goal keyframes of the cells not used for tuning, mjcf/workcells/press_shop.xml
 # (fixed base: `pick`, `place`), mjcf/workcells/shelf_bay.xml (fixed base: `pick`,
 # `place`), mjcf/workcells/rail_hall.xml (linear axis: `patch`, `mould`) and mjcf/workcells/low_beam.xml
-# (fixed base: `pick`; `place` is its mirror image, below),
+# (fixed base: `pick`; `place` is its mirror image, below), mjcf/workcells/round_pillars.xml and
+# mjcf/workcells/cad_cell.xml (fixed base: `pick`, `place`; their boxed twins, written by
+# tools/make_mesh_twins.py, copy the keyframes),
 # with leeway's own inverse kinematics, as tools/dlr_keyframes.sh does for DLR: tool0 on the goal
 # site, tool pointing straight down, elbow-up branch (seeded there, j4 = -pi); j6 has no effect on
 # the position or the tool axis, so it keeps its seed, j6 = j1 as in the thesis poses. Fixed base:
@@ -50,3 +52,9 @@ derive mjcf/workcells/rail_hall.xml mould mould rail_x
 # pick's with j1 and j6 negated (the IK from this seed lands on the j4 = +pi branch there instead).
 echo "mjcf/workcells/low_beam.xml:"
 derive mjcf/workcells/low_beam.xml pick pick
+echo "mjcf/workcells/round_pillars.xml:"
+derive mjcf/workcells/round_pillars.xml pick pick
+derive mjcf/workcells/round_pillars.xml place place
+echo "mjcf/workcells/cad_cell.xml:"
+derive mjcf/workcells/cad_cell.xml pick pick
+derive mjcf/workcells/cad_cell.xml place place

@@ -641,7 +641,7 @@ TEST_P(CertifyPropertyTest, WideWristRegionsCertifiedWithPivotBoxesAreFree) {
 
 INSTANTIATE_TEST_SUITE_P(CertifyCells, CertifyPropertyTest,
                          ::testing::Values("dallara", "baltico", "dlr", "rail_hall", "wide_elbow", "one_link",
-                                           "hammer", "telescope", "folding_hand", "round_arm"));
+                                           "hammer", "telescope", "folding_hand", "round_arm", "round_pillars", "cad_cell"));
 
 class CertifyTest : public test::MujocoTest {};
 

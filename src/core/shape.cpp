@@ -245,8 +245,9 @@ struct Simplex {
 Eigen::Vector3d Shape::support_point(const Eigen::Vector3d& n) const {
   if (type == mjGEOM_BOX || type == mjGEOM_HFIELD) {
     const Eigen::Vector3d local = box.rotation.transpose() * n;
-    Eigen::Vector3d corner;
-    for (int k = 0; k < 3; ++k) corner[k] = local[k] < 0 ? -box.half_size[k] : box.half_size[k];
+    Eigen::Vector3d corner = box.half_size;
+    for (int k = 0; k < 3; ++k)
+      if (local[k] < 0) corner[k] = -corner[k];
     return box.center + box.rotation * corner;
   }
   return origin + rotation * local_support(*this, rotation.transpose() * n);

@@ -35,6 +35,13 @@ const std::string kIrbUrdf = kUrdfDir + "/irb6700_205_280.urdf";
 const std::string kArm7Urdf = kUrdfDir + "/arm7.urdf";
 const std::string kIrbPackage = "leeway_test_irb6700";
 
+// Today's one-box-per-element import (LinkGeometry::kBox), which the tests written for it keep.
+UrdfImportOptions box_options() {
+  UrdfImportOptions o;
+  o.link_geometry = LinkGeometry::kBox;
+  return o;
+}
+
 // A path in single quotes, for the shell.
 std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
 
@@ -83,7 +90,7 @@ class UrdfImportTest : public test::MujocoTest {};
 TEST_F(UrdfImportTest, Irb6700MatchesTheHandWrittenModel) {
   test::TempDir dir;
   write_irb_package(dir.path() / "pkgs");
-  UrdfImportOptions options;
+  UrdfImportOptions options = box_options();
   options.package_paths = {(dir.path() / "pkgs").string()};
   const UrdfImport robot = import_urdf(kIrbUrdf, options);
   EXPECT_EQ(robot.robot_name, "abb_irb6700_205_280");
@@ -165,7 +172,7 @@ TEST_F(UrdfImportTest, PrimitiveShapesBecomeTheirBoxes) {
     <axis xyz="0 0 2"/><limit lower="-0.5" upper="0.25" effort="1" velocity="0.75"/></joint>
   <joint name="j1-tool0" type="fixed"><origin xyz="0.5 0 0"/><parent link="link_1"/><child link="tool0"/></joint>
 </robot>)");
-  const UrdfImport robot = import_urdf(urdf);
+  const UrdfImport robot = import_urdf(urdf, box_options());
   EXPECT_THAT(
       robot.mjcf,
       HasSubstr("<joint name=\"j1\" type=\"slide\" axis=\"0 0 1\" range=\"-0.5 0.25\" user=\"0.75\"/>"));
@@ -204,7 +211,7 @@ TEST_F(UrdfImportTest, MeshPathsFileUriRelativeAndScaledRotated) {
     <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
   <joint name="t" type="fixed"><parent link="link_1"/><child link="tool0"/></joint>
 </robot>)");
-  const Scene s = Scene::load(cell_around(dir, "meshes", import_urdf(urdf).mjcf, 1));
+  const Scene s = Scene::load(cell_around(dir, "meshes", import_urdf(urdf, box_options()).mjcf, 1));
   RobotState state(s);
   state.set(Eigen::VectorXd::Zero(1));
   const mjModel& m = s.model();
@@ -231,7 +238,7 @@ TEST_F(UrdfImportTest, FlatMeshesAreThickenedWithANote) {
     <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
   <joint name="t" type="fixed"><parent link="link_1"/><child link="tool0"/></joint>
 </robot>)");
-  const UrdfImport robot = import_urdf(urdf);
+  const UrdfImport robot = import_urdf(urdf, box_options());
   ASSERT_EQ(robot.notes.size(), 1u);
   EXPECT_THAT(robot.notes[0],
               AllOf(HasSubstr("link 'link_1' <collision> 1"), HasSubstr("half-size 0 m along box axis z"),
@@ -252,7 +259,7 @@ TEST_F(UrdfImportTest, OffChainJointsAreFrozenAndNoted) {
   <joint name="grip" type="prismatic"><parent link="tool0"/><child link="finger"/><axis xyz="1 0 0"/>
     <limit lower="0.01" upper="0.04" effort="1" velocity="1"/></joint>
 </robot>)");
-  const UrdfImport robot = import_urdf(urdf);
+  const UrdfImport robot = import_urdf(urdf, box_options());
   EXPECT_EQ(robot.joints, std::vector<std::string>{"j1"});
   ASSERT_EQ(robot.notes.size(), 1u);
   EXPECT_THAT(robot.notes[0], AllOf(HasSubstr("'grip'"), HasSubstr("frozen at 0.01 m")));
@@ -296,15 +303,16 @@ TEST(UrdfImportCliTest, PackagePathFlagAndEnvironmentGiveTheSameRobot) {
       << "<package><name>" << kIrbPackage << "</name></package>\n";
   const fs::path by_flag = dir.path() / "by_flag.xml", by_env = dir.path() / "by_env.xml";
   const std::string no_env = "env -u ROS_PACKAGE_PATH " + std::string(LEEWAY_CLI);
-  const auto r1 = test::run_program(no_env, "import-urdf " + kIrbUrdf + " --out " + quoted(by_flag) +
-                                                " --package-path " + quoted(dir.path() / "flag"));
+  const auto r1 =
+      test::run_program(no_env, "import-urdf " + kIrbUrdf + " --link-geometry box --out " + quoted(by_flag) +
+                                    " --package-path " + quoted(dir.path() / "flag"));
   ASSERT_EQ(r1.exit_code, 0) << r1.out;
   EXPECT_THAT(
       r1.out,
       HasSubstr("6 joints (joint_1, joint_2, joint_3, joint_4, joint_5, joint_6), 10 collision boxes"));
   const auto r2 =
       test::run_program("ROS_PACKAGE_PATH=/nonexistent:" + quoted(dir.path() / "env") + " " + LEEWAY_CLI,
-                        "import-urdf " + kIrbUrdf + " --out " + quoted(by_env));
+                        "import-urdf " + kIrbUrdf + " --link-geometry box --out " + quoted(by_env));
   ASSERT_EQ(r2.exit_code, 0) << r2.out;
   std::ifstream f1(by_flag), f2(by_env);
   const std::string t1((std::istreambuf_iterator<char>(f1)), {}),
@@ -465,7 +473,7 @@ TEST(UrdfImportCliTest, SevenJointArmEndToEnd) {
   fs::create_directories(dir.path() / "robots");
   fs::create_directories(dir.path() / "cells");
   const fs::path robot = dir.path() / "robots/arm7.xml", cell = dir.path() / "cells/arm7.xml";
-  const auto imp = test::run_cli("import-urdf " + kArm7Urdf + " --out " + quoted(robot));
+  const auto imp = test::run_cli("import-urdf " + kArm7Urdf + " --link-geometry box --out " + quoted(robot));
   ASSERT_EQ(imp.exit_code, 0) << imp.out;
   EXPECT_THAT(imp.out, HasSubstr("7 joints (a1, a2, a3, a4, a5, a6, a7), 8 collision boxes"));
   EXPECT_THAT(imp.out,
@@ -549,7 +557,7 @@ TEST(UrdfImportCliTest, FourJointArmPlansAndBounds) {
   const std::string source = dir.write("arm4.urdf", urdf);
   const fs::path robot = dir.path() / "arm4.xml", cell = dir.path() / "cell.xml",
                  path = dir.path() / "p.json", bounds = dir.path() / "b.json";
-  const auto imp = test::run_cli("import-urdf " + source + " --out " + quoted(robot));
+  const auto imp = test::run_cli("import-urdf " + source + " --link-geometry box --out " + quoted(robot));
   ASSERT_EQ(imp.exit_code, 0) << imp.out;
   EXPECT_THAT(imp.out, HasSubstr("4 joints (a1, a2, a3, a4)"));
   ASSERT_EQ(test::run_cli("new-cell --robot " + quoted(robot) + " --out " + quoted(cell)).exit_code, 0);
@@ -613,7 +621,7 @@ std::string cell_with_excludes(const test::TempDir& dir, const std::string& name
 
 TEST_F(UrdfImportTest, ExcludesTheBoxesThatOverlapAtTheReferenceConfiguration) {
   test::TempDir dir;
-  const UrdfImport robot = import_urdf(dir.write("overlap.urdf", kOverlapping));
+  const UrdfImport robot = import_urdf(dir.write("overlap.urdf", kOverlapping), box_options());
   EXPECT_EQ(robot.reference, "0.5 0 0");
   // Four boxes on a chain of four parts: 6 pairs, 3 of them parent and child; 1 excluded.
   ASSERT_EQ(robot.excludes.size(), 1u);
@@ -638,7 +646,7 @@ TEST_F(UrdfImportTest, ExcludesTheBoxesThatOverlapAtTheReferenceConfiguration) {
   EXPECT_TRUE(check_scene(s).ok());
 
   // Nothing to exclude: the fragment still compiles as an include (MuJoCo refuses an empty one).
-  const UrdfImport clean = import_urdf(dir.write("two.urdf", kTwoJoints));
+  const UrdfImport clean = import_urdf(dir.write("two.urdf", kTwoJoints), box_options());
   EXPECT_TRUE(clean.excludes.empty());
   EXPECT_THAT(clean.excludes_mjcf, HasSubstr("Nothing excluded"));
   EXPECT_EQ(Scene::load(cell_with_excludes(dir, "two", clean)).excluded_pairs().size(), 0u);
@@ -647,7 +655,7 @@ TEST_F(UrdfImportTest, ExcludesTheBoxesThatOverlapAtTheReferenceConfiguration) {
 TEST_F(UrdfImportTest, SrdfDisabledPairsAreExcludedWithTheirReason) {
   test::TempDir dir;
   const std::string urdf = dir.write("overlap.urdf", kOverlapping);
-  UrdfImportOptions options;
+  UrdfImportOptions options = box_options();
   options.srdf = dir.write("overlap.srdf", R"(<?xml version="1.0"?>
 <robot name="overlap">
   <group name="arm"><chain base_link="base_link" tip_link="tool0"/></group>
@@ -706,7 +714,8 @@ TEST(UrdfImportCliTest, ImportAndNewCellWriteAndPrintTheExcludes) {
   fs::create_directories(dir.path() / "robots");
   fs::create_directories(dir.path() / "cells");
   const fs::path robot = dir.path() / "robots/overlap.xml", cell = dir.path() / "cells/overlap.xml";
-  const auto imp = test::run_cli("import-urdf " + urdf + " --out " + quoted(robot) + " --srdf " + srdf);
+  const auto imp = test::run_cli("import-urdf " + urdf + " --link-geometry box --out " + quoted(robot) +
+                                 " --srdf " + srdf);
   ASSERT_EQ(imp.exit_code, 0) << imp.out;
   EXPECT_THAT(imp.out,
               AllOf(HasSubstr("wrote " + (dir.path() / "robots/overlap_excludes.xml").string() +
@@ -728,7 +737,7 @@ TEST(UrdfImportCliTest, ImportAndNewCellWriteAndPrintTheExcludes) {
 // The bundled robot mjcf/robots/wide_elbow.xml (and its excludes) is what import-urdf writes from
 // tests/data/urdf/wide_elbow.urdf; its cell passes the check (workcells_test.cpp).
 TEST_F(UrdfImportTest, TheBundledWideElbowRobotIsTheImportOfItsUrdf) {
-  const UrdfImport robot = import_urdf(kUrdfDir + "/wide_elbow.urdf");
+  const UrdfImport robot = import_urdf(kUrdfDir + "/wide_elbow.urdf", box_options());
   auto read = [](const std::string& path) {
     std::ifstream in(path);
     return std::string((std::istreambuf_iterator<char>(in)), {});
@@ -750,6 +759,214 @@ TEST_F(UrdfImportTest, TheBundledWideElbowRobotIsTheImportOfItsUrdf) {
 // (shared_ptr), so the loop was a cycle of owners that outlived the import (found by
 // fuzz/fuzz_urdf.cpp; fuzz/regressions/urdf/joint_loop_leak.urdf). Needs LeakSanitizer
 // (LEEWAY_SANITIZE=address).
+// ---- mesh geoms (LinkGeometry::kMesh, the default) ----
+
+// The triangles of the cuboid [lo, hi] turned about z by `yaw` [rad] and moved by `shift`.
+std::vector<test::Triangle> turned_cuboid(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double yaw,
+                                          const Eigen::Vector3d& shift = Eigen::Vector3d::Zero()) {
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  std::vector<test::Triangle> out = test::cuboid(lo, hi);
+  for (auto& t : out)
+    for (auto& v : t) v = r * v + shift;
+  return out;
+}
+
+// Writes an import as import-urdf does (fragment, excludes fragment, mesh copies) into dir/robots
+// and a cell dir/cells/NAME.xml around it with <compiler meshdir="../robots">; returns the cell.
+std::string cell_with_meshes(const test::TempDir& dir, const std::string& name, const UrdfImport& robot) {
+  const std::string cell = cell_with_excludes(dir, name, robot);
+  for (const UrdfMeshFile& m : robot.meshes) {
+    fs::create_directories((dir.path() / "robots" / m.file).parent_path());
+    std::ofstream(dir.path() / "robots" / m.file, std::ios::binary) << m.bytes;
+  }
+  std::ifstream in(cell);
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  text.replace(text.find("autolimits=\"true\""), 17, "autolimits=\"true\" meshdir=\"../robots\"");
+  return dir.write("cells/" + name + ".xml", text);
+}
+
+// One hinge; link_1's collision is an ASCII STL cuboid (8 corners), placed with an origin and scaled.
+const std::string kOneMeshLink = R"(<robot name="one_mesh">
+  <link name="base_link"/>
+  <link name="link_1"><collision><origin xyz="0.1 0.2 0.3" rpy="0.3 -0.2 0.5"/>
+    <geometry><mesh filename="part.stl" scale="2 1 0.5"/></geometry></collision></link>
+  <link name="tool0"/>
+  <joint name="j1" type="revolute"><origin xyz="0 0 0.4"/><parent link="base_link"/><child link="link_1"/>
+    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="2"/></joint>
+  <joint name="j1-tool0" type="fixed"><origin xyz="0.5 0 0"/><parent link="link_1"/><child link="tool0"/></joint>
+</robot>
+)";
+
+TEST_F(UrdfImportTest, MeshGeomHullIsTheStlsVerticesScaledWhereTheUrdfPutsThem) {
+  test::TempDir dir;
+  const Eigen::Vector3d lo(-0.1, 0.02, 0.0), hi(0.15, 0.12, 0.4);
+  test::write_ascii_stl((dir.path() / "part.stl").string(), test::cuboid(lo, hi));
+  const UrdfImport robot = import_urdf(dir.write("one_mesh.urdf", kOneMeshLink));
+  EXPECT_EQ(robot.boxes, 1);
+  ASSERT_EQ(robot.meshes.size(), 1u);
+  EXPECT_EQ(robot.meshes[0].file, "meshes/link_1_mesh.stl");
+  EXPECT_EQ(robot.meshes[0].bytes.size(), 84u + 50u * 12u);  // binary STL, 12 triangles
+  EXPECT_THAT(robot.mjcf, AllOf(HasSubstr("<geom name=\"link_1_mesh\" type=\"mesh\" mesh=\"link_1_mesh\""),
+                                HasSubstr("as a mesh geom on its binary STL copy")));
+  EXPECT_THAT(robot.excludes_mjcf,
+              HasSubstr("<mesh name=\"link_1_mesh\" file=\"meshes/link_1_mesh.stl\" scale=\"2 1 0.5\"/>"));
+
+  const Scene s = Scene::load(cell_with_meshes(dir, "one_mesh", robot));
+  const mjModel& m = s.model();
+  const int g = mj_name2id(&m, mjOBJ_GEOM, "link_1_mesh");
+  ASSERT_GE(g, 0);
+  ASSERT_EQ(m.geom_type[g], mjGEOM_MESH);
+  const int mesh = m.geom_dataid[g];
+  ASSERT_EQ(m.mesh_vertnum[mesh], 8);
+  // At j1 = 0.7 rad, each compiled vertex in the world is a corner of the scaled cuboid placed by
+  // the joint, the collision origin and the scale (MuJoCo's re-centring undone by the geom's pose).
+  RobotState state(s);
+  Eigen::VectorXd q(1);
+  q << 0.7;
+  state.set(q);
+  Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();
+  origin.translation() << 0.1, 0.2, 0.3;
+  origin.linear() =
+      (Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(-0.2, Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
+  Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
+  body.translation() << 0, 0, 0.4;
+  body.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Vector3d scale(2, 1, 0.5);
+  const Eigen::Map<const Eigen::Vector3d> xpos(state.data().geom_xpos + 3 * g);
+  const Eigen::Map<const Eigen::Matrix<mjtNum, 3, 3, Eigen::RowMajor>> xmat(state.data().geom_xmat + 9 * g);
+  std::vector<Eigen::Vector3d> compiled;
+  for (int v = 0; v < 8; ++v) {
+    const float* p = m.mesh_vert + 3 * (m.mesh_vertadr[mesh] + v);
+    compiled.push_back(xpos + xmat * Eigen::Vector3d(p[0], p[1], p[2]));
+  }
+  for (int i = 0; i < 8; ++i) {
+    const Eigen::Vector3d corner(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
+    const Eigen::Vector3d expected = body * origin * Eigen::Vector3d(corner.cwiseProduct(scale));
+    double nearest = 1e9;
+    for (const auto& c : compiled) nearest = std::min(nearest, (c - expected).norm());
+    EXPECT_LT(nearest, 1e-6) << "corner " << i;
+  }
+}
+
+// Three hinges about one axis with coincident frames: link_1 and link_3 each carry a thin rod
+// running diagonally (45 degrees) in the xy-plane, link_3's 0.3 m further along x: the rods are
+// 0.3 / sqrt(2) = 0.21 m apart, but their boxes in the mesh frames overlap.
+const std::string kDiagonalRods = R"(<robot name="rods">
+  <link name="base_link"/>
+  <link name="link_1"><collision><geometry><mesh filename="rod_a.stl"/></geometry></collision></link>
+  <link name="link_2"/>
+  <link name="link_3"><collision><geometry><mesh filename="rod_b.stl"/></geometry></collision></link>
+  <link name="tool0"/>
+  <joint name="j1" type="revolute"><origin xyz="0 0 0.1"/><parent link="base_link"/><child link="link_1"/>
+    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="2"/></joint>
+  <joint name="j2" type="revolute"><parent link="link_1"/><child link="link_2"/>
+    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="2"/></joint>
+  <joint name="j3" type="revolute"><parent link="link_2"/><child link="link_3"/>
+    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="2"/></joint>
+  <joint name="j3-tool0" type="fixed"><origin xyz="0.5 0 0"/><parent link="link_3"/><child link="tool0"/></joint>
+</robot>
+)";
+
+TEST_F(UrdfImportTest, MeshGeomsApartAreNotExcludedWhereTheirBoxesOverlap) {
+  test::TempDir dir;
+  const double yaw = 0.7853981633974483;
+  test::write_binary_stl((dir.path() / "rod_a.stl").string(),
+                         turned_cuboid({0, -0.01, -0.01}, {1, 0.01, 0.01}, yaw));
+  test::write_binary_stl((dir.path() / "rod_b.stl").string(),
+                         turned_cuboid({0, -0.01, -0.01}, {1, 0.01, 0.01}, yaw, {0.3, 0, 0}));
+  const std::string urdf = dir.write("rods.urdf", kDiagonalRods);
+  const UrdfImport boxes = import_urdf(urdf, box_options());
+  ASSERT_EQ(boxes.excludes.size(), 1u);
+  EXPECT_EQ(boxes.excludes[0].geom1, "link_1_box");
+  EXPECT_EQ(boxes.excludes[0].geom2, "link_3_box");
+  EXPECT_TRUE(boxes.meshes.empty());
+
+  const UrdfImport meshes = import_urdf(urdf);
+  EXPECT_TRUE(meshes.excludes.empty());
+  EXPECT_EQ(meshes.self_pairs, 1);
+  EXPECT_THAT(meshes.excludes_mjcf, HasSubstr("Nothing excluded: no two geoms checked"));
+  // The pair is checked: at the reference the hulls are apart; with j3 turned they meet.
+  const Scene s = Scene::load(cell_with_meshes(dir, "rods", meshes));
+  EXPECT_TRUE(check_scene(s).ok());
+  RobotState state(s);
+  EXPECT_FALSE(state.in_collision(Eigen::Vector3d(0, 0, 0)));
+  EXPECT_TRUE(state.in_collision(Eigen::Vector3d(0, 0, 0.4)));
+}
+
+// The same rods touching at the reference (link_3's rod crossing link_1's): excluded in mesh mode
+// too, with the reason naming the geoms.
+TEST_F(UrdfImportTest, MeshGeomsTouchingAtTheReferenceAreExcluded) {
+  test::TempDir dir;
+  test::write_binary_stl((dir.path() / "rod_a.stl").string(),
+                         turned_cuboid({0, -0.01, -0.01}, {1, 0.01, 0.01}, 0.78));
+  test::write_binary_stl((dir.path() / "rod_b.stl").string(),
+                         turned_cuboid({0, -0.01, -0.01}, {1, 0.01, 0.01}, 0.0));
+  const UrdfImport robot = import_urdf(dir.write("rods.urdf", kDiagonalRods));
+  ASSERT_EQ(robot.excludes.size(), 1u);
+  EXPECT_EQ(robot.excludes[0].geom1, "link_1_mesh");
+  EXPECT_THAT(robot.excludes[0].reason,
+              AllOf(HasSubstr("the geoms overlap by"), HasSubstr("a mesh geom is its convex hull")));
+}
+
+TEST(UrdfImportCliTest, MeshImportNewCellAndCheck) {
+  test::TempDir dir;
+  const double yaw = 0.7853981633974483;
+  test::write_binary_stl((dir.path() / "rod_a.stl").string(),
+                         turned_cuboid({0, -0.01, -0.01}, {1, 0.01, 0.01}, yaw));
+  test::write_ascii_stl((dir.path() / "rod_b.stl").string(),
+                        turned_cuboid({0, -0.01, -0.01}, {1, 0.01, 0.01}, yaw, {0.3, 0, 0}));
+  const std::string urdf = dir.write("rods.urdf", kDiagonalRods);
+  fs::create_directories(dir.path() / "robots");
+  fs::create_directories(dir.path() / "cells");
+  const fs::path robot = dir.path() / "robots" / "rods.xml", cell = dir.path() / "cells" / "rods.xml";
+  const auto imp = test::run_cli("import-urdf " + urdf + " --out " + quoted(robot));
+  ASSERT_EQ(imp.exit_code, 0) << imp.out;
+  EXPECT_THAT(imp.out, AllOf(HasSubstr("2 collision geoms, 2 of them meshes"),
+                             HasSubstr("0 geom pair(s) excluded from self-collision, 1 checked")));
+  EXPECT_TRUE(fs::is_regular_file(dir.path() / "robots" / "rods_meshes" / "link_1_mesh.stl"));
+  EXPECT_TRUE(fs::is_regular_file(dir.path() / "robots" / "rods_meshes" / "link_3_mesh.stl"));
+  const auto nc = test::run_cli("new-cell --robot " + quoted(robot) + " --out " + quoted(cell));
+  ASSERT_EQ(nc.exit_code, 0) << nc.out;
+  std::ifstream in(cell);
+  const std::string text((std::istreambuf_iterator<char>(in)), {});
+  EXPECT_THAT(text, HasSubstr("meshdir=\"../robots\""));
+  const auto check = test::run_cli("check " + quoted(cell));
+  EXPECT_EQ(check.exit_code, 0) << check.out;
+  // --link-geometry box writes no meshes; an unknown value is refused before anything is written.
+  const fs::path boxed = dir.path() / "robots" / "boxed.xml";
+  const auto box = test::run_cli("import-urdf " + urdf + " --link-geometry box --out " + quoted(boxed));
+  ASSERT_EQ(box.exit_code, 0) << box.out;
+  EXPECT_THAT(box.out, HasSubstr("2 collision boxes"));
+  EXPECT_FALSE(fs::exists(dir.path() / "robots" / "boxed_meshes"));
+  const fs::path other = dir.path() / "robots" / "other.xml";
+  const auto bad = test::run_cli("import-urdf " + urdf + " --link-geometry hull --out " + quoted(other));
+  EXPECT_EQ(bad.exit_code, 2) << bad.out;
+  EXPECT_THAT(bad.out, HasSubstr("--link-geometry"));
+  EXPECT_FALSE(fs::exists(other));
+  EXPECT_FALSE(fs::exists(dir.path() / "robots" / "other_meshes"));
+}
+
+TEST(UrdfImportCliTest, AMeshMuJoCoCannotCompileExitsTwoWithNoFile) {
+  test::TempDir dir;
+  // A flat mesh: one triangle, no volume.
+  test::write_binary_stl(
+      (dir.path() / "rod_a.stl").string(),
+      {test::Triangle{Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0)}});
+  test::write_binary_stl((dir.path() / "rod_b.stl").string(), test::cuboid({0.5, 0.5, 0}, {0.6, 0.6, 0.1}));
+  const std::string urdf = dir.write("rods.urdf", kDiagonalRods);
+  const fs::path out = dir.path() / "flat.xml";
+  const auto r = test::run_cli("import-urdf " + urdf + " --out " + quoted(out));
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_THAT(r.out,
+              AllOf(HasSubstr("link 'link_1' <collision> 1 <mesh> filename 'rod_a.stl'"),
+                    HasSubstr("MuJoCo cannot compile it as a mesh geom"), HasSubstr("--link-geometry box")));
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(dir.path() / "flat_excludes.xml"));
+  EXPECT_FALSE(fs::exists(dir.path() / "flat_meshes"));
+}
+
 TEST(UrdfImportLeakTest, RefusedJointLoopsLeaveNoLeak) {
 #ifndef LEEWAY_TEST_ASAN
   GTEST_SKIP() << "needs LeakSanitizer: build with LEEWAY_SANITIZE=address";

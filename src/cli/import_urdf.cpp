@@ -1,6 +1,7 @@
 #include "cli/import_urdf.hpp"
 
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 
 #include "cli/common.hpp"
@@ -30,8 +31,41 @@ CLI::App* add_import_urdf(CLI::App& app, ImportUrdfArgs& args) {
   sub->add_option("--srdf", args.srdf,
                   "An SRDF file (MoveIt): its <disable_collisions> link pairs are excluded from\n"
                   "self-collision too");
+  sub->add_option("--link-geometry", args.link_geometry,
+                  "What each <collision> element becomes: mesh (its own shape: a box, cylinder or sphere\n"
+                  "as such, an STL mesh as a mesh geom, collided as its convex hull, on a binary STL copy\n"
+                  "in STEM_meshes/ beside --out) or box (one box that contains it)")
+      ->check(CLI::IsMember({"mesh", "box"}))
+      ->capture_default_str();
   return sub;
 }
+
+namespace {
+
+// The mesh copies, into `folder` (created when missing), each checked against the inputs and the
+// other outputs first; a folder created here is removed again when a check fails.
+void write_mesh_copies(const UrdfImport& robot, const std::string& folder, std::vector<OutputFile> outputs,
+                       const std::vector<std::string>& read) {
+  if (robot.meshes.empty()) return;
+  namespace fs = std::filesystem;
+  const fs::path dir(folder);
+  std::error_code ec;
+  const bool created = fs::create_directory(dir, ec);
+  if (ec)
+    throw InputError("--out " + folder + ": cannot create the folder of the mesh copies: " + ec.message());
+  try {
+    for (const UrdfMeshFile& m : robot.meshes)
+      outputs.push_back({(dir / fs::path(m.file).filename()).string(), "--out (a mesh copy)", {".stl"}});
+    require_outputs(outputs, read);
+  } catch (...) {
+    if (created) fs::remove(dir, ec);
+    throw;
+  }
+  for (const UrdfMeshFile& m : robot.meshes)
+    write_file_atomic((dir / fs::path(m.file).filename()).string(), m.bytes);
+}
+
+}  // namespace
 
 int run_import_urdf(const ImportUrdfArgs& args) {
   // The excludes fragment goes beside the robot fragment, where new-cell looks for it.
@@ -48,6 +82,9 @@ int run_import_urdf(const ImportUrdfArgs& args) {
   options.base_link = args.base_link;
   options.continuous_full_turn = args.continuous_full_turn;
   options.srdf = args.srdf;
+  options.link_geometry = parse_link_geometry(args.link_geometry);
+  const std::string mesh_folder = mesh_folder_path(args.out);
+  options.mesh_folder = std::filesystem::path(mesh_folder).filename().string();
   UrdfImport robot;
   try {
     robot = import_urdf(args.urdf, options);
@@ -56,20 +93,30 @@ int run_import_urdf(const ImportUrdfArgs& args) {
     const std::string& f = e.field();
     const std::string flag = f == "continuous_full_turn" ? "--continuous-full-turn"
                              : f == "tool_link"          ? "--tool LINK"
+                             : f == "link_geometry"      ? "--link-geometry box"
                                                          : "--base-link LINK";
     throw InputError(std::string(e.what()) + " (see " + flag + ")");
   }
   // The meshes the URDF names are known once it is read: the outputs may replace none of them.
   read.insert(read.end(), robot.inputs.begin(), robot.inputs.end());
   require_outputs(outputs, read);
+  write_mesh_copies(robot, mesh_folder, outputs, read);
   write_file_atomic(excludes, robot.excludes_mjcf);
   write_file_atomic(args.out, robot.mjcf);
   std::cout << "wrote " << args.out << ": robot '" << robot.robot_name << "', " << robot.joints.size()
             << " joints (";
   for (size_t i = 0; i < robot.joints.size(); ++i) std::cout << (i ? ", " : "") << robot.joints[i];
-  std::cout << "), " << robot.boxes << " collision boxes\n";
+  if (options.link_geometry == LinkGeometry::kBox)
+    std::cout << "), " << robot.boxes << " collision boxes\n";
+  else
+    std::cout << "), " << robot.boxes << " collision geoms, " << robot.meshes.size() << " of them meshes\n";
+  if (!robot.meshes.empty())
+    std::cout << "wrote " << robot.meshes.size() << " binary STL mesh copies in " << mesh_folder
+              << " (a cell in another folder needs <compiler meshdir> naming the robot's folder; new-cell "
+                 "writes it)\n";
   std::cout << "wrote " << excludes << ": " << robot.excludes.size()
-            << " box pair(s) excluded from self-collision, " << robot.self_pairs
+            << (options.link_geometry == LinkGeometry::kBox ? " box" : " geom")
+            << " pair(s) excluded from self-collision, " << robot.self_pairs
             << " checked (include it at the top level of the cell; new-cell does)\n";
   for (const auto& e : robot.excludes)
     std::cout << "excluded: '" << e.geom1 << "' and '" << e.geom2 << "': " << e.reason << "\n";

@@ -23,10 +23,10 @@ namespace {
 namespace fs = std::filesystem;
 
 // `excludes_include`: the robot's excludes fragment ("" none); `excludes`: leeway_exclude texts with
-// their comments, written in the cell's own <custom>.
+// their comments, written in the cell's own <custom>; `meshdir`: the <compiler meshdir> ("" none).
 std::string cell_text(const std::string& model_name, const std::string& include, const std::string& robot,
                       double reach, const std::string& home, const std::string& excludes_include,
-                      const std::string& excludes) {
+                      const std::string& excludes, const std::string& meshdir) {
   const double floor = std::max(5.0, std::ceil(reach) + 1.0);
   std::ostringstream x;
   x.imbue(std::locale::classic());
@@ -39,7 +39,8 @@ std::string cell_text(const std::string& model_name, const std::string& include,
     << "  radians.\n"
     << "-->\n"
     << "<mujoco model=\"" << detail::xml_escape(model_name) << "\">\n"
-    << "  <compiler angle=\"radian\" autolimits=\"true\"/>\n\n"
+    << "  <compiler angle=\"radian\" autolimits=\"true\""
+    << (meshdir.empty() ? "" : " meshdir=\"" + detail::xml_escape(meshdir) + "\"") << "/>\n\n"
     << "  <custom>\n"
     << "    <!-- [m] an upper bound of the robot's reach from its first hinge (link boxes and tool site) "
        "-->\n"
@@ -155,11 +156,19 @@ NewCell write_new_cell(const std::string& robot_path, const std::string& cell_pa
   // The robot's excludes fragment: given, or the one import-urdf writes beside the robot.
   const std::string excludes = excludes_path.empty() ? leeway::excludes_path(robot_path) : excludes_path;
   if (fs::is_regular_file(excludes, ec)) out.excludes_include = include_path(excludes, cell_path);
+  // Its mesh assets (import-urdf's mesh geoms) name their files relative to the robot's folder, and
+  // MuJoCo 2.2.2 reads them relative to the cell's folder and meshdir.
+  if (!out.excludes_include.empty() && read_mjcf_source(excludes).files.size() > 1) {
+    const std::string robot_dir = fs::absolute(robot_path).lexically_normal().parent_path().string();
+    const fs::path rel = include_path(robot_dir, cell_path);
+    if (rel != "." && !rel.empty()) out.meshdir = rel.string();
+  }
   const std::string robot_name = fs::path(robot_path).filename().string();
 
   // First the cell without keyframes, to learn the robot's joints and reach, and the pairs that
   // touch at home.
-  std::string text = cell_text(model_name, out.robot_include, robot_name, 2.8, "", out.excludes_include, "");
+  std::string text =
+      cell_text(model_name, out.robot_include, robot_name, 2.8, "", out.excludes_include, "", out.meshdir);
   text.erase(text.find("  <keyframe>"), text.find("</mujoco>") - text.find("  <keyframe>"));
   const Scene probe = load_beside(cell_path, text);
   const Eigen::VectorXd home =
@@ -196,7 +205,7 @@ NewCell write_new_cell(const std::string& robot_path, const std::string& cell_pa
     out.cell_excludes.push_back(std::move(e));
   }
   out.mjcf = cell_text(model_name, out.robot_include, robot_name, out.reach_radius, out.home,
-                       out.excludes_include, texts);
+                       out.excludes_include, texts, out.meshdir);
 
   // Then the cell itself, checked before it is moved into place.
   std::vector<std::string> inputs;

@@ -6,16 +6,21 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <deque>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include "leeway/core/file_io.hpp"
 #include "leeway/core/kinematics.hpp"
@@ -209,10 +214,83 @@ std::vector<std::string> split_paths(const std::string& list) {
 
 struct Geom {
   std::string name, comment;
-  std::string link;  // the URDF link it came from (SRDF entries name links)
-  Isometry3d pose;   // in the body's frame
-  Vector3d half;     // [m]
+  std::string link;          // the URDF link it came from (SRDF entries name links)
+  Isometry3d pose;           // in the body's frame
+  std::string type = "box";  // the MuJoCo geom type: box, cylinder, sphere or mesh
+  Vector3d half;     // [m] a box's half-sizes; a cylinder's radius, radius, half-length; a sphere's radius
+  std::string mesh;  // a mesh geom's asset (named as the geom)
 };
+
+// A mesh asset of the excludes fragment and the copy it reads.
+struct MeshAsset {
+  std::string name, what;  // the asset (= the geom's name); the collision element, for messages
+  std::string scale;       // the URDF's scale attribute; empty when 1 1 1
+  UrdfMeshFile file;
+};
+
+// A binary STL of `vertices` (three per triangle) as 32-bit little-endian floats, with the facet
+// normals, and `header` (which must not start with "solid") in the 80-byte header.
+std::string binary_stl(const std::vector<Vector3d>& vertices, const std::string& header) {
+  std::string out(80, '\0');
+  out.replace(0, std::min<size_t>(header.size(), 80), header.substr(0, 80));
+  auto put_u32 = [&](std::uint32_t v) {
+    for (int k = 0; k < 4; ++k) out.push_back(static_cast<char>((v >> (8 * k)) & 0xFF));
+  };
+  auto put = [&](const Vector3d& p) {
+    for (int k = 0; k < 3; ++k) {
+      const float f = static_cast<float>(p[k]);
+      std::uint32_t bits = 0;
+      std::memcpy(&bits, &f, sizeof f);
+      put_u32(bits);
+    }
+  };
+  put_u32(static_cast<std::uint32_t>(vertices.size() / 3));
+  for (size_t t = 0; t + 2 < vertices.size(); t += 3) {
+    const Vector3d n = (vertices[t + 1] - vertices[t]).cross(vertices[t + 2] - vertices[t]);
+    put(n.norm() > 0 ? Vector3d(n.normalized()) : Vector3d::Zero());
+    for (size_t v = t; v < t + 3; ++v) put(vertices[v]);
+    out.append(2, '\0');  // attribute byte count
+  }
+  return out;
+}
+
+// Compiles MJCF text as the virtual file `path` with `files` {name, bytes} beside it in MuJoCo's
+// virtual file system (MuJoCo 2.2.2 finds a virtual file by its name without folders, so a mesh
+// asset whose path ends in that name reads it): the import checks its mesh geoms before it writes
+// anything. As load_model_text, with MuJoCo's message on one line.
+// @throws InputError "PATH: MJCF does not compile: ...".
+ModelPtr load_text_with_files(const std::string& xml, const std::string& path,
+                              const std::vector<std::pair<std::string, std::string>>& files) {
+  install_mujoco_error_handlers();
+  auto vfs = std::make_unique<mjVFS>();
+  mj_defaultVFS(vfs.get());
+  std::vector<std::pair<std::string, std::string>> all = {{path, xml}};
+  all.insert(all.end(), files.begin(), files.end());
+  for (const auto& [name, bytes] : all) {
+    if (mj_makeEmptyFileVFS(vfs.get(), name.c_str(), static_cast<int>(bytes.size())) != 0) {
+      mj_deleteVFS(vfs.get());
+      throw std::runtime_error("cannot allocate a MuJoCo virtual file for " + name);
+    }
+    std::memcpy(vfs->filedata[vfs->nfile - 1], bytes.data(), bytes.size());
+  }
+  char error[1024] = "";
+  mjModel* m = mj_loadXML(path.c_str(), vfs.get(), error, sizeof(error));
+  mj_deleteVFS(vfs.get());
+  if (!m) {
+    std::string msg(error);
+    for (size_t p = msg.find('\n'); p != std::string::npos; p = msg.find('\n', p))
+      msg.replace(p, 1, p + 1 < msg.size() ? "; " : "");
+    throw InputError(path + ": MJCF does not compile: " + msg);
+  }
+  return ModelPtr(m);
+}
+
+// `name` as a file name: characters other than letters, digits, '_', '-' and '.' become '_'.
+std::string file_safe(std::string name) {
+  for (char& ch : name)
+    if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '_' && ch != '-' && ch != '.') ch = '_';
+  return name;
+}
 
 struct Body {
   std::string link, comment;
@@ -451,6 +529,7 @@ class Importer {
   void add_collisions(const urdf::Link& link, size_t b, const Isometry3d& t, const std::string& via) {
     std::vector<urdf::CollisionSharedPtr> collisions = link.collision_array;
     if (collisions.empty() && link.collision) collisions.push_back(link.collision);
+    const bool boxes = options_.link_geometry == LinkGeometry::kBox;
     int index = 0;
     for (const auto& c : collisions) {
       ++index;
@@ -474,31 +553,33 @@ class Importer {
           require_positive(
               g.half, what + " <cylinder> radius '" + num(cy.radius) + "' length '" + num(cy.length) + "'");
           shape = "cylinder radius " + num(cy.radius) + " m, length " + num(cy.length) +
-                  " m as its tight box (axis = box z)";
+                  (boxes ? " m as its tight box (axis = box z)" : " m (exact)");
+          if (!boxes) g.type = "cylinder";
           break;
         }
         case urdf::Geometry::SPHERE: {
           const double r = static_cast<const urdf::Sphere&>(*c->geometry).radius;
           g.half = Vector3d::Constant(r);
           require_positive(g.half, what + " <sphere> radius '" + num(r) + "'");
-          shape = "sphere radius " + num(r) + " m as its bounding cube";
+          shape = "sphere radius " + num(r) + (boxes ? " m as its bounding cube" : " m (exact)");
+          if (!boxes) g.type = "sphere";
           break;
         }
         case urdf::Geometry::MESH: {
           const auto& mesh = static_cast<const urdf::Mesh&>(*c->geometry);
-          shape = mesh_box(mesh, what, g);
+          shape = mesh_shape(mesh, what, link.name, c->name, collisions.size() > 1 ? index : 0, g);
           break;
         }
         default:
           throw InputError(what + " has a geometry leeway does not know");
       }
-      for (int k = 0; k < 3; ++k)
+      for (int k = 0; k < 3 && g.type == "box"; ++k)
         if (g.half[k] < kMinHalfSize) {
           notes_.push_back(what + ": half-size " + num(g.half[k]) + " m along box axis " + "xyz"[k] +
                            " thickened to " + num(kMinHalfSize) + " m");
           g.half[k] = kMinHalfSize;
         }
-      g.name = geom_name(link.name, c->name, collisions.size() > 1 ? index : 0);
+      if (g.name.empty()) g.name = geom_name(link.name, c->name, collisions.size() > 1 ? index : 0, g.type);
       g.link = link.name;
       g.comment = (via.empty() ? "" : via + ", ") + "collision " + std::to_string(index) +
                   (c->name.empty() ? "" : " '" + c->name + "'") + ": " + shape;
@@ -511,7 +592,10 @@ class Importer {
       throw InputError(what + " must be finite and positive [m]");
   }
 
-  std::string mesh_box(const urdf::Mesh& mesh, const std::string& what, Geom& g) {
+  // An STL <mesh> as its bounding box (LinkGeometry::kBox) or as a mesh geom on a binary copy of it
+  // (kMesh, which also names the geom); returns how the shape was taken.
+  std::string mesh_shape(const urdf::Mesh& mesh, const std::string& what, const std::string& link,
+                         const std::string& collision, int index, Geom& g) {
     const std::string m = what + " <mesh> filename '" + mesh.filename + "'";
     const std::string path = resolve_urdf_resource(mesh.filename, urdf_dir_, options_, m);
     std::string ext = fs::path(path).extension().string();
@@ -532,6 +616,29 @@ class Importer {
     } catch (const InputError& e) {
       throw InputError(m + ": " + e.what());
     }
+    const std::string source =
+        "mesh '" + mesh.filename + "' (" + std::to_string(stl.triangles()) + " triangles, " +
+        (stl.binary ? "binary" : "ASCII") + " STL" +
+        (scale == Vector3d::Ones() ? std::string() : ", scale " + vector3_text(mesh.scale)) + ")";
+    if (options_.link_geometry == LinkGeometry::kMesh) {
+      g.type = "mesh";
+      g.name = geom_name(link, collision, index, "mesh");
+      g.mesh = g.name;
+      MeshAsset a;
+      a.name = g.name;
+      a.what = m;
+      if (scale != Vector3d::Ones()) a.scale = vector3_text(mesh.scale);
+      std::string file = file_safe(g.name);
+      for (int k = 2; !mesh_files_.insert(file).second; ++k)
+        file = file_safe(g.name) + "_" + std::to_string(k);
+      a.file.file = options_.mesh_folder + "/" + file + ".stl";
+      a.file.source = path;
+      a.file.bytes = binary_stl(
+          stl.vertices, "leeway import-urdf: binary STL copy of " + fs::path(path).filename().string());
+      mesh_assets_.push_back(std::move(a));
+      return source + " as a mesh geom on its binary STL copy '" + mesh_assets_.back().file.file +
+             "' (MuJoCo collides it as its convex hull)";
+    }
     std::vector<Vector3d> points;
     points.reserve(stl.vertices.size());
     for (const auto& v : stl.vertices) points.push_back(v.cwiseProduct(scale));
@@ -540,29 +647,27 @@ class Importer {
     Isometry3d offset = Isometry3d::Identity();
     offset.translation() = (hi + lo) / 2;
     g.pose = g.pose * offset;
-    return "mesh '" + mesh.filename + "' (" + std::to_string(stl.triangles()) + " triangles, " +
-           (stl.binary ? "binary" : "ASCII") + " STL" +
-           (scale == Vector3d::Ones() ? std::string() : ", scale " + vector3_text(mesh.scale)) +
-           ") as its axis-aligned bounding box in the mesh's frame";
+    return source + " as its axis-aligned bounding box in the mesh's frame";
   }
 
   // LINK_box for a link's only collision element (whatever its name: ROS-Industrial names them all
-  // "collision"), else LINK_NAME_box for a named one and LINK_box_K for the K-th unnamed one.
-  std::string geom_name(const std::string& link, const std::string& collision, int index) {
-    std::string base = link + "_box";
+  // "collision"), else LINK_NAME_box for a named one and LINK_box_K for the K-th unnamed one; with
+  // LinkGeometry::kMesh the geom's type instead of "box" (LINK_mesh, LINK_cylinder, ...).
+  std::string geom_name(const std::string& link, const std::string& collision, int index,
+                        const std::string& type) {
+    std::string base = link + "_" + type;
     if (index > 0)
-      base = collision.empty() ? base + "_" + std::to_string(index) : link + "_" + collision + "_box";
+      base = collision.empty() ? base + "_" + std::to_string(index) : link + "_" + collision + "_" + type;
     std::string name = base;
     for (int k = 2; !geom_names_.insert(name).second; ++k) name = base + "_" + std::to_string(k);
     return name;
   }
 
-  UrdfImport write(const std::string& base, const std::string& tool) {
-    UrdfImport out;
-    out.robot_name = model_->getName();
+  // The robot fragment's header comment: where it came from, how to include it, its geoms.
+  std::string header(const std::string& robot, const std::string& base, const std::string& tool) const {
     std::ostringstream x;
     x << "<!--\n"
-      << "  Robot '" << comment_text(out.robot_name) << "' imported from the URDF '"
+      << "  Robot '" << comment_text(robot) << "' imported from the URDF '"
       << comment_text(fs::path(file_).filename().string()) << "' by leeway import-urdf (docs/robots.md).\n"
       << "  Base link '" << comment_text(base) << "', tool link '" << comment_text(tool)
       << "' (the site tool0).\n"
@@ -570,15 +675,50 @@ class Importer {
       << "  <compiler angle=\"radian\" autolimits=\"true\"/>. Units: metres, radians; joint user[0] is the\n"
       << "  URDF's <limit velocity> [rad/s or m/s].\n"
       << "  Every body frame is its URDF link frame (= its joint frame); links fixed to a moving link are\n"
-      << "  merged into it. Collision: one box per URDF <collision> element (a box exactly, a cylinder as\n"
-      << "  its tight box, a sphere as its cube, an STL mesh as its axis-aligned bounding box in the\n"
-      << "  mesh's frame): the boxes contain the URDF's shapes, so leeway's checks err on the safe side.\n"
-      << "  Robot geoms: contype=\"1\" conaffinity=\"0\" (they touch obstacles); leeway checks them\n"
+      << "  merged into it. ";
+    if (options_.link_geometry == LinkGeometry::kBox)
+      x << "Collision: one box per URDF <collision> element (a box exactly, a cylinder as\n"
+        << "  its tight box, a sphere as its cube, an STL mesh as its axis-aligned bounding box in the\n"
+        << "  mesh's frame): the boxes contain the URDF's shapes, so leeway's checks err on the safe side.\n";
+    else
+      x << "Collision: one geom per URDF <collision> element, its own shape (a box,\n"
+        << "  cylinder or sphere exactly; an STL mesh as a mesh geom on its binary STL copy in the folder\n"
+        << "  '" << comment_text(options_.mesh_folder)
+        << "' beside this file). MuJoCo collides a mesh geom as the\n"
+        << "  convex hull of its vertices, which contains the mesh, so leeway's checks err on the safe "
+           "side.\n"
+        << "  The mesh assets are in the excludes fragment; MuJoCo 2.2.2 reads mesh files from the folder\n"
+        << "  of the cell (the main file) and its <compiler meshdir>, so a cell in another folder sets\n"
+        << "  meshdir to this file's folder (leeway new-cell does).\n";
+    x << "  Robot geoms: contype=\"1\" conaffinity=\"0\" (they touch obstacles); leeway checks them\n"
       << "  against each other by its own rule (docs/mjcf-conventions.md, \"Self-collision\"). The pairs\n"
       << "  excluded from that check are in the second fragment written beside this one\n"
       << "  (NAME_excludes.xml for NAME.xml), which the cell includes at its top level.\n";
     for (const auto& n : notes_) x << "  Note: " << comment_text(n) << "\n";
-    x << "-->\n<mujoco>\n";
+    x << "-->\n";
+    return x.str();
+  }
+
+  // A <geom> element (after its comment line), in body `body` (0: the base).
+  static std::string geom_element(const Geom& g, const std::string& indent, size_t body) {
+    std::string shape = "type=\"" + g.type + "\"";
+    if (g.type == "mesh")
+      shape += " mesh=\"" + xml_escape(g.mesh) + "\" " + pose_attributes(g.pose);
+    else if (g.type == "cylinder")
+      shape += " " + pose_attributes(g.pose) + " size=\"" + num(g.half.x()) + " " + num(g.half.z()) + "\"";
+    else if (g.type == "sphere")
+      shape += " " + pose_attributes(g.pose) + " size=\"" + num(g.half.x()) + "\"";
+    else
+      shape += " " + pose_attributes(g.pose) + " size=\"" + vec(g.half) + "\"";
+    return indent + "<geom name=\"" + xml_escape(g.name) + "\" " + shape + "\n" + indent +
+           "      contype=\"1\" conaffinity=\"0\" rgba=\"" + (body == 0 ? kBaseRgba : kLinkRgba) + "\"/>\n";
+  }
+
+  UrdfImport write(const std::string& base, const std::string& tool) {
+    UrdfImport out;
+    out.robot_name = model_->getName();
+    std::ostringstream x;
+    x << header(out.robot_name, base, tool) << "<mujoco>\n";
     std::string indent = "  ";
     for (size_t i = 0; i < bodies_.size(); ++i) {
       const Body& b = bodies_[i];
@@ -603,11 +743,7 @@ class Importer {
           << indent << "<inertial pos=\"0 0 0\" mass=\"0.001\" diaginertia=\"1e-06 1e-06 1e-06\"/>\n";
       }
       for (const Geom& g : b.geoms) {
-        x << indent << "<!-- " << comment_text(g.comment) << " -->\n";
-        x << indent << "<geom name=\"" << xml_escape(g.name) << "\" type=\"box\" " << pose_attributes(g.pose)
-          << " size=\"" << vec(g.half) << "\"\n"
-          << indent << "      contype=\"1\" conaffinity=\"0\" rgba=\"" << (i == 0 ? kBaseRgba : kLinkRgba)
-          << "\"/>\n";
+        x << indent << "<!-- " << comment_text(g.comment) << " -->\n" << geom_element(g, indent, i);
         ++out.boxes;
       }
       if (b.tool) {
@@ -630,19 +766,43 @@ class Importer {
     return out;
   }
 
-  // The fragment's bodies inside a world body: a cell leeway's Scene can load.
+  // The fragment's bodies inside a world body, with the mesh assets: a cell leeway's Scene can load.
   std::string as_cell(const std::string& fragment, const std::string& custom) const {
     const size_t a = fragment.find("<mujoco>\n"), b = fragment.rfind("</mujoco>");
     LEEWAY_DEMAND(a != std::string::npos && b != std::string::npos && a < b);
-    return "<mujoco>\n<compiler angle=\"radian\" autolimits=\"true\"/>\n" + custom + "<worldbody>\n" +
-           fragment.substr(a + 9, b - a - 9) + "</worldbody>\n</mujoco>\n";
+    return "<mujoco>\n<compiler angle=\"radian\" autolimits=\"true\"/>\n" + asset_text() + custom +
+           "<worldbody>\n" + fragment.substr(a + 9, b - a - 9) + "</worldbody>\n</mujoco>\n";
   }
 
+  // The <asset> of the mesh geoms (indented for the excludes fragment); empty without meshes.
+  std::string asset_text() const {
+    if (mesh_assets_.empty()) return "";
+    std::string x = "  <asset>\n";
+    for (const MeshAsset& a : mesh_assets_)
+      x += "    <mesh name=\"" + xml_escape(a.name) + "\" file=\"" + xml_escape(a.file.file) + "\"" +
+           (a.scale.empty() ? "" : " scale=\"" + a.scale + "\"") + "/>\n";
+    return x + "  </asset>\n";
+  }
+
+  // Loads the cell text with the mesh copies as virtual files (nothing is written yet). MuJoCo's
+  // refusal of a mesh is reported for its collision element.
   Scene load_cell(const std::string& text) const {
+    std::vector<std::pair<std::string, std::string>> files;
+    for (const MeshAsset& a : mesh_assets_)
+      files.emplace_back(fs::path(a.file.file).filename().string(), a.file.bytes);
     try {
-      return Scene::from_model(load_model_text(text, file_ + ".leeway.xml"), file_);
+      return Scene::from_model(load_text_with_files(text, file_ + ".leeway.xml", files), file_);
     } catch (const InputError& e) {
-      throw InputError(file_ + ": the imported robot does not load as a leeway robot: " + e.what());
+      const std::string what = e.what();
+      for (const MeshAsset& a : mesh_assets_)
+        if (what.find("Object name = " + a.name + ",") != std::string::npos)
+          throw UrdfOptionError(a.what + ": MuJoCo cannot compile it as a mesh geom (" +
+                                    what.substr(what.find(": MJCF does not compile: ") == std::string::npos
+                                                    ? 0
+                                                    : what.find(": MJCF does not compile: ") + 25) +
+                                    "); import it as its bounding box instead",
+                                "link_geometry");
+      throw InputError(file_ + ": the imported robot does not load as a leeway robot: " + what);
     }
   }
 
@@ -657,13 +817,20 @@ class Importer {
     std::map<std::pair<int, int>, std::vector<std::string>> why;
     std::map<std::pair<int, int>, double> depth;
     RobotState state(scene);
+    const bool boxes = options_.link_geometry == LinkGeometry::kBox;
     for (const SelfContact& c : self_contacts_within(state, q, kTouch)) {
       depth[key(c.geom1, c.geom2)] = c.depth;
+      const bool two_boxes = m.geom_type[c.geom1] == mjGEOM_BOX && m.geom_type[c.geom2] == mjGEOM_BOX;
+      const std::string touch = boxes       ? "the boxes touch (within " + num(kTouch) + " m)"
+                                : two_boxes ? "the geoms touch (within " + num(kTouch) + " m)"
+                                            : "the geoms touch";
       why[key(c.geom1, c.geom2)].push_back(
-          (c.depth > kTouch ? "the boxes overlap by " + format_number(c.depth) + " m"
-                            : "the boxes touch (within " + num(kTouch) + " m)") +
+          (c.depth > kTouch ? (boxes ? "the boxes" : "the geoms") + std::string(" overlap by ") +
+                                  format_number(c.depth) + " m"
+                            : touch) +
           " at the reference configuration (every joint at 0 or the limit nearest 0), where the arm is "
-          "taken to stand clear of itself: an artefact of the box approximation; check it");
+          "taken to stand clear of itself: an artefact of the " +
+          (boxes ? "box approximation" : "collision shapes (a mesh geom is its convex hull)") + "; check it");
     }
     std::string srdf_note;
     if (!options_.srdf.empty()) {
@@ -683,7 +850,8 @@ class Importer {
       for (const auto& r : w->second) e.reason += (e.reason.empty() ? "" : "; and ") + r;
       for (const std::string* g : {&e.geom1, &e.geom2})
         if (g->find_first_of(" \t\r\n") != std::string::npos)
-          throw InputError(file_ + ": box '" + *g + "' must be excluded from self-collision (" + e.reason +
+          throw InputError(file_ + (boxes ? ": box '" : ": geom '") + *g +
+                           "' must be excluded from self-collision (" + e.reason +
                            "), but a name with white space cannot be: rename its link");
       std::string name = "leeway_exclude_" + e.geom1 + "_" + e.geom2;
       for (int k = 2; !text_names.insert(name).second; ++k)
@@ -700,13 +868,21 @@ class Importer {
       << "' by leeway import-urdf (docs/robots.md).\n"
       << "  Include this file at the top level of the cell, beside <worldbody> (an include inside the\n"
       << "  world body cannot carry <custom>); leeway new-cell does. leeway checks every other pair of\n"
-      << "  robot boxes on parts that are neither the same nor parent and child\n"
+      << "  robot " << (boxes ? "boxes" : "geoms")
+      << " on parts that are neither the same nor parent and child\n"
       << "  (docs/mjcf-conventions.md, \"Self-collision\").\n";
+    if (!mesh_assets_.empty())
+      x << "  The <asset> holds the meshes of the robot's mesh geoms: binary STL copies in the folder\n"
+        << "  '" << comment_text(options_.mesh_folder)
+        << "' beside the robot fragment, named relative to it (MuJoCo 2.2.2 reads them from the\n"
+        << "  cell's folder and its <compiler meshdir>: a cell in another folder sets meshdir to the robot\n"
+        << "  fragment's folder).\n";
     if (!srdf_note.empty()) x << "  Note: " << comment_text(srdf_note) << "\n";
-    x << "-->\n<mujoco>\n";
+    x << "-->\n<mujoco>\n" << asset_text();
     if (texts.empty())
       // MuJoCo refuses an include without elements: an empty <custom> stands in.
-      x << "  <!-- Nothing excluded: no two boxes checked against each other touch at the reference\n"
+      x << "  <!-- Nothing excluded: no two " << (boxes ? "boxes" : "geoms")
+        << " checked against each other touch at the reference\n"
         << "       configuration (every joint at 0 or the limit nearest 0)"
         << (options_.srdf.empty() ? "" : ", and the SRDF disables no such pair") << ". -->\n"
         << "  <custom/>\n";
@@ -720,6 +896,7 @@ class Importer {
         load_cell(as_cell(out.mjcf, texts.empty() ? "" : "<custom>\n" + texts + "</custom>\n"));
     LEEWAY_DEMAND(with.excluded_pairs().size() == out.excludes.size());
     out.self_pairs = static_cast<int>(with.self_pairs().size());
+    for (const MeshAsset& a : mesh_assets_) out.meshes.push_back(a.file);
   }
 
   // The SRDF's <disable_collisions> entries, as reasons for the box pairs of the two links that
@@ -788,7 +965,9 @@ class Importer {
     }
     return "the SRDF '" + name + "' disables " + std::to_string(entries) + " link pair(s); " +
            std::to_string(unchecked) +
-           " of them have no box pair leeway checks (one rigid part, parent and child, or no boxes)";
+           (options_.link_geometry == LinkGeometry::kBox
+                ? " of them have no box pair leeway checks (one rigid part, parent and child, or no boxes)"
+                : " of them have no geom pair leeway checks (one rigid part, parent and child, or no geoms)");
   }
 
   std::string file_, urdf_dir_;
@@ -799,6 +978,8 @@ class Importer {
   std::vector<std::string> notes_;
   std::vector<std::string> meshes_read_;
   std::set<std::string> geom_names_;
+  std::vector<MeshAsset> mesh_assets_;  // LinkGeometry::kMesh: in the order of their geoms
+  std::set<std::string> mesh_files_;    // the copies' file names (without .stl)
 };
 
 }  // namespace
@@ -837,6 +1018,19 @@ std::string resolve_urdf_resource(const std::string& uri, const std::string& urd
                      "' has a scheme leeway does not read (package://, file:// or a path)");
   if (path.empty()) throw InputError(what + ": empty file name");
   return fs::path(path).is_absolute() ? path : (fs::path(urdf_dir) / path).string();
+}
+
+const char* link_geometry_name(LinkGeometry g) { return g == LinkGeometry::kBox ? "box" : "mesh"; }
+
+LinkGeometry parse_link_geometry(const std::string& name) {
+  if (name == "mesh") return LinkGeometry::kMesh;
+  if (name == "box") return LinkGeometry::kBox;
+  throw InputError("link geometry '" + name + "' is not one of: mesh, box");
+}
+
+std::string mesh_folder_path(const std::string& robot_path) {
+  const fs::path p(robot_path);
+  return (p.parent_path() / (p.stem().string() + "_meshes")).string();
 }
 
 UrdfImport import_urdf(const std::string& urdf_path, const UrdfImportOptions& options) {

@@ -28,6 +28,10 @@ struct NewCell {
   //! empty when there is none.
   std::string excludes_include;
   int included_excludes = 0;  //!< pairs that fragment excludes
+  //! The <compiler meshdir> written: the robot's folder relative to the cell's when the excludes
+  //! fragment names mesh files (import-urdf's mesh geoms) and the cell is in another folder; else
+  //! empty (none written).
+  std::string meshdir;
   //! Pairs that still touched at the home keyframe, excluded in the cell itself (with a comment each).
   std::vector<CellExclude> cell_excludes;
   int self_pairs = 0;  //!< robot geom pairs the cell checks for self-collision
@@ -40,8 +44,10 @@ struct NewCell {
 //! first hinge joint, rounded up to 0.1 m. Self-collision: the excludes fragment `excludes_path`
 //! (empty: excludes_path(robot_path) from urdf_import.hpp when that file exists) is included at the
 //! top level, and every robot geom pair still touching at `home` is excluded in the cell itself as a
-//! leeway_exclude custom text with a comment giving the overlap. The file is written atomically and
-//! only once the cell compiles and passes the check.
+//! leeway_exclude custom text with a comment giving the overlap. When the excludes fragment names
+//! mesh files (import-urdf's mesh geoms, named relative to the robot's folder) and the cell is in
+//! another folder, the cell's <compiler meshdir> names the robot's folder relative to the cell. The file is
+//! written atomically and only once the cell compiles and passes the check.
 //! @throws InputError naming the file when the robot or the given excludes file is missing, the
 //! cell does not compile or is not a usable leeway cell (the robot recognised by
 //! docs/mjcf-conventions.md), or the check fails.

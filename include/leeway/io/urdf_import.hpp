@@ -2,8 +2,10 @@
 //! @file urdf_import.hpp
 //! A URDF robot (ROS, ROS-Industrial) turned into an MJCF robot fragment in leeway's conventions
 //! (docs/mjcf-conventions.md, "Writing your own robot"; docs/robots.md): one body per moving link
-//! with its frame at the joint, fixed links merged into their parent, one box per collision element,
-//! and the self-collision excludes the boxes need (a second fragment, for the cell's top level).
+//! with its frame at the joint, fixed links merged into their parent, one geom per collision element
+//! (the URDF's shape, a collision mesh as a MuJoCo mesh geom; or one box each), and the self-collision
+//! excludes those geoms need (a second fragment, for the cell's top level, which also holds the mesh
+//! assets).
 
 #include <string>
 #include <utility>
@@ -12,6 +14,22 @@
 #include "leeway/core/error.hpp"
 
 namespace leeway {
+
+//! What each URDF <collision> element becomes.
+enum class LinkGeometry {
+  //! Its own shape: a box, cylinder or sphere as the same MuJoCo primitive, an STL mesh as a mesh
+  //! geom (which MuJoCo collides as its convex hull) on a binary STL copy of the mesh.
+  kMesh,
+  //! One box that contains it (a mesh: the axis-aligned bounding box of its vertices in its frame).
+  kBox,
+};
+
+//! "mesh" or "box".
+const char* link_geometry_name(LinkGeometry g);
+
+//! The LinkGeometry named "mesh" or "box".
+//! @throws InputError naming the value when it is neither.
+LinkGeometry parse_link_geometry(const std::string& name);
 
 //! How a URDF is imported.
 struct UrdfImportOptions {
@@ -27,6 +45,17 @@ struct UrdfImportOptions {
   //! An SRDF file (MoveIt's semantic description) whose <disable_collisions link1 link2 reason>
   //! pairs are excluded too; empty: none.
   std::string srdf;
+  LinkGeometry link_geometry = LinkGeometry::kMesh;  //!< shapes as they are, or one box each
+  //! With LinkGeometry::kMesh: the folder of the mesh copies, as the fragments name it (relative to
+  //! the robot fragment's folder; see mesh_folder_path).
+  std::string mesh_folder = "meshes";
+};
+
+//! A binary STL copy of a collision mesh, for the mesh asset that names it.
+struct UrdfMeshFile {
+  std::string file;    //!< as the <mesh file> attribute names it: MESH_FOLDER/GEOM.stl
+  std::string source;  //!< the STL file it copies (as resolved)
+  std::string bytes;   //!< the binary STL (the source's vertices as 32-bit floats, unscaled)
 };
 
 //! A pair of robot boxes the import excludes from self-collision, and why.
@@ -42,11 +71,15 @@ struct UrdfImport {
   std::string robot_name;           //!< the URDF's <robot name>
   std::string mjcf;                 //!< the MJCF fragment (a <mujoco> element to include in <worldbody>)
   std::vector<std::string> joints;  //!< robot joints in model order
-  int boxes = 0;                    //!< collision boxes written
+  int boxes = 0;                    //!< collision geoms written (all of them boxes with LinkGeometry::kBox)
   //! The excludes fragment: a <mujoco> element whose <custom> holds one leeway_exclude text per
-  //! entry of `excludes`, each with a comment saying why; include it at the top level of a cell
-  //! (beside <worldbody>: an include inside it cannot carry <custom>). Written even when empty.
+  //! entry of `excludes`, each with a comment saying why, and with mesh geoms the <asset> of their
+  //! meshes; include it at the top level of a cell (beside <worldbody>: an include inside it can
+  //! carry neither <custom> nor <asset>). Written even when empty.
   std::string excludes_mjcf;
+  //! The mesh copies the excludes fragment's assets name (LinkGeometry::kMesh), to be written
+  //! beside the robot fragment.
+  std::vector<UrdfMeshFile> meshes;
   //! The pairs excluded: every pair of boxes leeway would check for self-collision (Scene::self_pairs())
   //! that overlaps at the reference configuration, and the SRDF's disabled pairs; in the order of
   //! Scene::self_pairs().
@@ -62,12 +95,14 @@ struct UrdfImport {
 };
 
 //! An import that one of UrdfImportOptions' fields would let through (a continuous joint, a
-//! missing tool or base link); `field` names it so a program can name its own option.
+//! missing tool or base link, a mesh MuJoCo cannot compile); `field` names it so a program can name
+//! its own option.
 class UrdfOptionError : public InputError {
  public:
   UrdfOptionError(const std::string& message, std::string field)
       : InputError(message), field_(std::move(field)) {}
-  //! "continuous_full_turn", "tool_link" or "base_link".
+  //! "continuous_full_turn", "tool_link", "base_link" or "link_geometry" (a mesh MuJoCo cannot
+  //! compile as a mesh geom, which LinkGeometry::kBox imports as its box).
   const std::string& field() const { return field_; }
 
  private:
@@ -78,16 +113,19 @@ class UrdfOptionError : public InputError {
 //! base link to the tool link: its revolute, continuous and prismatic joints become hinge and slide
 //! joints with the URDF's limits and user[0] = <limit velocity>; every other link below the base is
 //! merged into the body it hangs from, with joints off the chain frozen at 0 (clamped to their
-//! limits). The result is loaded as a cell with leeway's Scene: every pair of boxes that it checks for
-//! self-collision and that touches at the reference configuration (every joint at 0, or at the
-//! limit nearest 0: what new-cell's home keyframe is) is excluded, with the overlap in a comment;
-//! the URDF's zero pose is collision-free for the real arm, so such an overlap is the boxes'.
+//! limits). Collision elements become geoms as options.link_geometry says. The result is loaded as a
+//! cell with leeway's Scene (mesh geoms as MuJoCo compiles them, on their convex hulls): every pair
+//! of geoms that it checks for self-collision and that touches at the reference configuration (every
+//! joint at 0, or at the limit nearest 0: what new-cell's home keyframe is; boxes within 1e-6 m, other
+//! geoms by MuJoCo's collision function) is excluded, with the overlap in a comment; the URDF's zero
+//! pose is collision-free for the real arm, so such an overlap is the approximation's.
 //! Deterministic: the same file and options give the same text.
 //! @throws InputError naming the file, element and value: unreadable or invalid URDF (urdfdom's
 //! message), a link with two parent joints (a loop), a pose, size or limit that is not a finite
-//! number or is empty, a mesh that cannot be resolved, found or read as STL, a chain joint that is
-//! floating, planar or mimics another, no moving joint or no collision element on the moving links,
-//! an SRDF that cannot be read or names a link the URDF does not have;
+//! number or is empty, a mesh that cannot be resolved, found or read as STL, or (as a mesh geom)
+//! that MuJoCo cannot compile, a chain joint that is floating, planar or mimics another, no moving
+//! joint or no collision element on the moving links, an SRDF that cannot be read or names a link
+//! the URDF does not have;
 //! UrdfOptionError for an unknown base or tool link or a refused continuous joint.
 UrdfImport import_urdf(const std::string& urdf_path, const UrdfImportOptions& options = {});
 
@@ -95,6 +133,10 @@ UrdfImport import_urdf(const std::string& urdf_path, const UrdfImportOptions& op
 //! STEM_excludes.EXT (mjcf/robots/NAME.xml: mjcf/robots/NAME_excludes.xml). import-urdf writes it
 //! there and new-cell includes it from there.
 std::string excludes_path(const std::string& robot_path);
+
+//! Where the mesh copies of the robot fragment `robot_path` live: the folder STEM_meshes beside it
+//! (mjcf/robots/NAME.xml: mjcf/robots/NAME_meshes). import-urdf writes them there.
+std::string mesh_folder_path(const std::string& robot_path);
 
 //! The file a URDF resource refers to: `package://NAME/rest` through the package paths of
 //! `options`, `file://` paths and plain paths (relative ones from `urdf_dir`).

@@ -145,6 +145,8 @@ void Certifier::add_links(RobotState& state) {
                                        bodies.size(), offset));
     }
     link.corner_lever = std::isfinite(b0.half_size.norm()) ? b0.half_size.norm() : 0.0;
+    link.mesh = m.geom_type[g] == mjGEOM_MESH;
+    if (link.mesh) link.hull = hull_extent(m, g);
     pivots_of_.emplace_back();
     if (std::isfinite(link.corner_lever)) add_pivots(state, link, bodies, jids, body_of_joint, robot_index);
     links_.push_back(std::move(link));
@@ -260,6 +262,7 @@ void Certifier::add_self_pairs() {
     sp.shared = shared_joints(links_[static_cast<size_t>(sp.link)], common);
     sp.other_geom = rp.geom1;
     sp.other_link = link_of[static_cast<size_t>(rp.geom1)];
+    sp.other_chain = sp.other_link;
     if (sp.other_link >= 0) {
       const LinkChain& ol = links_[static_cast<size_t>(sp.other_link)];
       sp.other_shared = shared_joints(ol, common);
@@ -413,7 +416,9 @@ bool Certifier::leaf_free_impl(CertifyContext& ctx, const Eigen::VectorXd& lower
     const int li = self ? pair_info->link : pair / static_cast<int>(nobs);
     const int held = self ? pair_info->shared : 0;
     if (self) {
-      other_at_c = geom_shape(m, d, pair_info->other_geom);
+      const LinkChain* chain =
+          pair_info->other_chain >= 0 ? &links_[static_cast<size_t>(pair_info->other_chain)] : nullptr;
+      other_at_c = geom_shape(m, d, pair_info->other_geom, chain && chain->mesh ? &chain->hull : nullptr);
       other = other_geom_swept(ctx, *pair_info, other_at_c);
     }
     const SweepObstacle& obs = self ? other : obstacles_[static_cast<size_t>(pair) % nobs];

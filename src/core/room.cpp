@@ -43,6 +43,8 @@ struct Moved {
   double lever = 1.0;
   bool link = false;  // a link geom: checked against the obstacles
   Shape shape;        // at the sweep's current configuration (shape.box holds it)
+  bool mesh = false;  // a mesh: its hull's extent, computed once
+  HullExtent hull;
 };
 
 // A geom the joint does not move (an obstacle, or the other geom of a self pair): its shape stays.
@@ -70,7 +72,8 @@ Sweep sweep_of(const Scene& scene, const mjData& d, int i) {
   std::vector<int> index(static_cast<size_t>(m.ngeom), -1);
   auto moved = [&](int g) {
     if (index[static_cast<size_t>(g)] >= 0) return static_cast<size_t>(index[static_cast<size_t>(g)]);
-    Moved out{g, 1.0, false, geom_shape(m, d, g)};
+    Moved out{g, 1.0, false, geom_shape(m, d, g), m.geom_type[g] == mjGEOM_MESH, HullExtent{}};
+    if (out.mesh) out.hull = hull_extent(m, g);
     if (!joint.prismatic) {
       out.lever = 1e-9;
       for (const Eigen::Vector3d& corner : box_corners(out.shape.box)) {
@@ -116,7 +119,7 @@ double gap(const Moved& g, const Fixed& f, double margin, double limit) {
 // whose boxes are apart allows at least kSelfFloor of it. The moved geoms' boxes are updated to the
 // configuration of `d` first.
 double sweep_step(const mjModel& m, const mjData& d, Sweep& sweep, double sampled) {
-  for (Moved& g : sweep.moved) g.shape = geom_shape(m, d, g.geom);
+  for (Moved& g : sweep.moved) g.shape = geom_shape(m, d, g.geom, g.mesh ? &g.hull : nullptr);
   double step = sweep.planes ? sampled : INFINITY;
   for (const Fixed& o : sweep.obstacles)
     for (const Moved& g : sweep.moved) {

@@ -42,8 +42,21 @@ Eigen::Vector3d local_support(const Shape& s, const Eigen::Vector3d& n) {
     }
     case mjGEOM_MESH: {
       int best = 0;
-      double top = -INFINITY;
-      for (int k = 0; k < s.count; ++k) {
+      double top = n.dot(vertex(s, 0));
+      if (s.edges) {  // climb the hull's edges: a linear function has no other local maximum on it
+        for (int from = -1; from != best;) {
+          from = best;
+          for (int e = s.edge_adr[from]; s.edges[e] >= 0; ++e) {
+            const double v = n.dot(vertex(s, s.edges[e]));
+            if (v > top) {
+              top = v;
+              best = s.edges[e];
+            }
+          }
+        }
+        return vertex(s, best);
+      }
+      for (int k = 1; k < s.count; ++k) {
         const double v = n.dot(vertex(s, k));
         if (v > top) {
           top = v;
@@ -95,15 +108,19 @@ Box mesh_box(const Shape& s, bool fixed) {
 }
 
 // A mesh geom's vertices: its convex hull's, when MuJoCo computed it (mesh_graph: numvert, numface,
-// the vertices' edge addresses, then their ids), else all of them (the same support).
+// the vertices' edge addresses, their ids, then each vertex's neighbours ending in -1), else all of
+// them (the same support).
 void take_hull(const mjModel& m, int geom, Shape& s) {
   const int mesh = m.geom_dataid[geom];
   s.vertices = m.mesh_vert + 3 * m.mesh_vertadr[mesh];
   s.count = m.mesh_vertnum[mesh];
   const int graph = m.mesh_graphadr[mesh];
   if (graph >= 0) {
-    s.count = m.mesh_graph[graph];
-    s.ids = m.mesh_graph + graph + 2 + s.count;
+    const int* g = m.mesh_graph + graph;
+    s.count = g[0];
+    s.edge_adr = g + 2;
+    s.ids = g + 2 + s.count;
+    s.edges = g + 2 + 2 * s.count;
   }
 }
 
@@ -277,7 +294,7 @@ Shape box_shape(const Box& box) {
   return s;
 }
 
-Shape geom_shape(const mjModel& m, const mjData& d, int geom) {
+Shape geom_shape(const mjModel& m, const mjData& d, int geom, const HullExtent* extent) {
   Shape s;
   s.type = m.geom_type[geom];
   s.origin = vec3(d.geom_xpos + 3 * geom);
@@ -286,7 +303,15 @@ Shape geom_shape(const mjModel& m, const mjData& d, int geom) {
   switch (s.type) {
     case mjGEOM_MESH: {
       take_hull(m, geom, s);
-      s.box = mesh_box(s, m.body_weldid[m.geom_bodyid[geom]] == 0);
+      const bool fixed = m.body_weldid[m.geom_bodyid[geom]] == 0;
+      if (extent && !fixed) {
+        s.box.center = s.origin + s.rotation * extent->centre;
+        s.box.rotation = s.rotation;
+        s.box.half_size = extent->half_size;
+        s.radius = extent->radius;
+        return s;
+      }
+      s.box = mesh_box(s, fixed);
       s.radius = 0;
       for (int k = 0; k < s.count; ++k)
         s.radius = std::max(s.radius, (s.origin + s.rotation * vertex(s, k) - s.box.center).norm());
@@ -330,11 +355,15 @@ Shape geom_shape(const mjModel& m, const mjData& d, int geom) {
   return s;
 }
 
-Eigen::AlignedBox3d mesh_local_bounds(const mjModel& m, int geom) {
+HullExtent hull_extent(const mjModel& m, int geom) {
   Shape s;
   take_hull(m, geom, s);
-  Eigen::AlignedBox3d out;
-  for (int k = 0; k < s.count; ++k) out.extend(vertex(s, k));
+  Eigen::AlignedBox3d box;
+  for (int k = 0; k < s.count; ++k) box.extend(vertex(s, k));
+  HullExtent out;
+  out.centre = box.center();
+  out.half_size = box.sizes() / 2;
+  for (int k = 0; k < s.count; ++k) out.radius = std::max(out.radius, (vertex(s, k) - out.centre).norm());
   return out;
 }
 

@@ -48,7 +48,7 @@ void SweptLink::start(const LinkChain& link, int link_id, const Eigen::VectorXd&
     box_.half_size = link.half_size;
     shape_ = box_shape(box_);
   } else {
-    shape_ = geom_shape(m, d, link.geom);
+    shape_ = geom_shape(m, d, link.geom, link.mesh ? &link.hull : nullptr);
     box_ = shape_.box;
   }
   hl_ = *hv;

@@ -179,8 +179,9 @@ std::string pool_xml(const Scene& scene, int pool) {
         x << "type=\"box\" size=\"" << size[0] << " " << size[1] << " " << size[2] << "\"/>";
         break;
       case mjGEOM_MESH: {  // the box about the geom's origin that holds its hull
-        const Eigen::AlignedBox3d b = mesh_local_bounds(m, g);
-        const Eigen::Vector3d h = b.min().cwiseAbs().cwiseMax(b.max().cwiseAbs());
+        const HullExtent e = hull_extent(m, g);
+        const Eigen::Vector3d h =
+            (e.centre - e.half_size).cwiseAbs().cwiseMax((e.centre + e.half_size).cwiseAbs());
         x << "type=\"box\" size=\"" << h[0] << " " << h[1] << " " << h[2] << "\"/>";
         break;
       }

@@ -185,6 +185,7 @@ class Certifier {
     int other_geom = -1;
     int other_link = -1;
     int other_shared = 0;
+    int other_chain = -1;  // the other geom's link (its hull extent), -1 for a robot base geom
   };
 
   void add_links(RobotState& state);

@@ -25,6 +25,11 @@ struct Shape {
   const float* vertices = nullptr;
   const int* ids = nullptr;
   int count = 0;
+  //! The hull's edges (MuJoCo's mesh_graph, when it computed the hull): the neighbours of hull
+  //! vertex k are edges[edge_adr[k]], edges[edge_adr[k] + 1], ... up to a -1. The support then
+  //! climbs from vertex to better neighbour, which on a convex polytope ends at the maximum.
+  const int* edge_adr = nullptr;
+  const int* edges = nullptr;
   //! The box that holds the shape (the shape itself for a box; infinite for a plane) [m].
   Box box;
   //! The radius of a ball about box.center that holds the shape [m] (infinite for a plane).
@@ -42,11 +47,22 @@ struct Shape {
 //! A box as a shape.
 Shape box_shape(const Box& box);
 
-//! The box of a mesh geom's convex hull in the geom's own frame (its vertices' extremes) [m].
-Eigen::AlignedBox3d mesh_local_bounds(const mjModel& m, int geom);
+//! A mesh geom's hull in its own frame: the box of its vertices and the radius of a ball about that
+//! box's centre that holds them [m]. Constant for a model: callers that build a moving mesh's shape
+//! often (the certificate, the room sweep) compute it once.
+struct HullExtent {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  Eigen::Vector3d half_size = Eigen::Vector3d::Zero();
+  double radius = 0.0;
+};
+
+//! A mesh geom's HullExtent.
+HullExtent hull_extent(const mjModel& m, int geom);
 
 //! The shape of a geom after kinematics (d.geom_xpos, d.geom_xmat), as MuJoCo's collision sees it.
-Shape geom_shape(const mjModel& m, const mjData& d, int geom);
+//! For a mesh on a moving body, `extent` (its hull_extent, when given) saves the pass over the
+//! hull's vertices that its box and radius need.
+Shape geom_shape(const mjModel& m, const mjData& d, int geom, const HullExtent* extent = nullptr);
 
 //! The result of convex_distance.
 struct ShapeDistance {

@@ -24,6 +24,9 @@ struct LinkChain {
   std::vector<bool> slide;     //!< per entry: a prismatic joint
   std::vector<double> lever;   //!< per entry: bound of |x - o_j| over all configurations [m]
   double corner_lever = 0.0;   //!< bound of |corner - x| of the geom's box [m]
+  //! A mesh geom's hull in its own frame (computed once; `mesh` false for other types).
+  bool mesh = false;
+  HullExtent hull;
   //! A pivot box (body >= 0) instead of the geom's own box: a box fixed on `body`, the body of
   //! chain entry `frozen_from` (a hinge), that holds the geom at every value of that joint and of
   //! every later one. Entries from `frozen_from` on are then held at the leaf's centre: the box

@@ -58,12 +58,24 @@ Vector3d closest_on_triangle(const Vector3d& p, const Vector3d& a, const Vector3
   return a + ab * (vb / denom) + ac * (vc / denom);
 }
 
+// The solid angle of the triangle (a, b, c) seen from the origin [sr], signed by its orientation
+// (Van Oosterom and Strackee).
+double solid_angle(const Vector3d& a, const Vector3d& b, const Vector3d& c) {
+  const double la = a.norm(), lb = b.norm(), lc = c.norm();
+  const double num = a.dot(b.cross(c));
+  const double den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+  return 2 * std::atan2(num, den);
+}
+
 class PartSolid {
  public:
-  PartSolid(std::vector<Vector3d> triangles, bool closed) : tri_(std::move(triangles)), closed_(closed) {
+  // `triangles` three vertices per triangle, `ids` their welded vertex numbers (equal ids: equal
+  // positions).
+  PartSolid(std::vector<Vector3d> triangles, const std::vector<int>& ids, bool closed, double eps)
+      : tri_(std::move(triangles)), closed_(closed), eps_(eps) {
     std::vector<int> order(tri_.size() / 3);
     std::iota(order.begin(), order.end(), 0);
-    root_ = build(order, 0, static_cast<int>(order.size()));
+    root_ = build(order, 0, static_cast<int>(order.size()), ids);
     order_ = std::move(order);
   }
 
@@ -93,17 +105,43 @@ class PartSolid {
   }
 
   // Inside the solid a closed mesh bounds: its generalized winding number (the triangles' solid
-  // angles over 4 pi, Van Oosterom and Strackee) is at least 1/2 in magnitude.
+  // angles over 4 pi) is at least 1/2 in magnitude. A tree node whose box p lies outside (by more
+  // than eps) counts by its boundary instead of its triangles, when that is shorter: its triangles
+  // and the fan from the box's centre over its boundary edges, reversed, form a closed surface
+  // within the box, whose winding number is 0 outside the box, so the triangles' solid angle is
+  // the fan's over the edges as they run (exact, not an approximation).
   bool inside(const Vector3d& p) const {
     double omega = 0;
-    for (size_t t = 0; t < tri_.size(); t += 3) {
-      const Vector3d a = tri_[t] - p, b = tri_[t + 1] - p, c = tri_[t + 2] - p;
-      const double la = a.norm(), lb = b.norm(), lc = c.norm();
-      const double num = a.dot(b.cross(c));
-      const double den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
-      omega += 2 * std::atan2(num, den);
+    std::vector<int> stack = {root_};
+    while (!stack.empty()) {
+      const Node& node = nodes_[stack.back()];
+      stack.pop_back();
+      const bool outside =
+          ((node.lo.array() - eps_ > p.array()) || (p.array() > node.hi.array() + eps_)).any();
+      if (outside && node.edge_count < node.triangles) {
+        const Vector3d c = 0.5 * (node.lo + node.hi) - p;
+        for (int e = node.edge_first; e < node.edge_first + node.edge_count; ++e)
+          omega += solid_angle(c, tri_[edges_[e].first] - p, tri_[edges_[e].second] - p);
+      } else if (node.left < 0) {
+        for (int i = node.first; i < node.first + node.count; ++i) {
+          const int t = 3 * order_[i];
+          omega += solid_angle(tri_[t] - p, tri_[t + 1] - p, tri_[t + 2] - p);
+        }
+      } else {
+        stack.push_back(node.left);
+        stack.push_back(node.right);
+      }
     }
     return std::abs(omega) >= 2 * M_PI;
+  }
+
+  // The generalized winding number at p summed over every triangle (the reference inside() must
+  // equal; for tests).
+  double winding_number_brute(const Vector3d& p) const {
+    double omega = 0;
+    for (size_t t = 0; t < tri_.size(); t += 3)
+      omega += solid_angle(tri_[t] - p, tri_[t + 1] - p, tri_[t + 2] - p);
+    return omega / (4 * M_PI);
   }
 
   // Distance to the solid (closed) or to the surface (open) [m].
@@ -116,17 +154,45 @@ class PartSolid {
   struct Node {
     Vector3d lo, hi;
     int left = -1, right = -1, first = 0, count = 0;  // children, or the leaf's triangles in order_
+    int triangles = 0;                                // below this node
+    int edge_first = 0, edge_count = 0;               // its boundary's directed edges in edges_
   };
 
-  int build(std::vector<int>& order, int first, int last) {
+  // The node's boundary: its triangles' directed edges (corner indices into tri_) less those that
+  // run both ways (by welded vertex), each left once per uncancelled use.
+  std::vector<std::pair<int, int>> boundary(const std::vector<std::pair<int, int>>& edges,
+                                            const std::vector<int>& ids) const {
+    std::unordered_map<std::uint64_t, std::vector<std::pair<int, int>>> net;  // by (low id, high id)
+    std::vector<std::uint64_t> keys;
+    for (const auto& e : edges) {
+      const std::uint64_t a = static_cast<std::uint32_t>(ids[e.first]),
+                          b = static_cast<std::uint32_t>(ids[e.second]);
+      if (a == b) continue;
+      const std::uint64_t key = std::min(a, b) << 32 | std::max(a, b);
+      auto& list = net[key];
+      if (list.empty()) keys.push_back(key);
+      if (!list.empty() && ids[list.back().first] != ids[e.first])
+        list.pop_back();  // runs the other way: they cancel
+      else
+        list.push_back(e);
+    }
+    std::vector<std::pair<int, int>> out;
+    for (const auto key : keys)
+      for (const auto& e : net[key]) out.push_back(e);
+    return out;
+  }
+
+  int build(std::vector<int>& order, int first, int last, const std::vector<int>& ids) {
     Node node;
     node.lo = Vector3d::Constant(std::numeric_limits<double>::infinity());
     node.hi = -node.lo;
+    node.triangles = last - first;
     for (int i = first; i < last; ++i)
       for (int k = 0; k < 3; ++k) {
         node.lo = node.lo.cwiseMin(tri_[3 * order[i] + k]);
         node.hi = node.hi.cwiseMax(tri_[3 * order[i] + k]);
       }
+    std::vector<std::pair<int, int>> edges;
     if (last - first > 4) {
       int axis = 0;
       (node.hi - node.lo).maxCoeff(&axis);
@@ -134,11 +200,27 @@ class PartSolid {
       auto centre = [&](int t) { return tri_[3 * t][axis] + tri_[3 * t + 1][axis] + tri_[3 * t + 2][axis]; };
       std::nth_element(order.begin() + first, order.begin() + mid, order.begin() + last,
                        [&](int a, int b) { return centre(a) < centre(b); });
-      node.left = build(order, first, mid);
-      node.right = build(order, mid, last);
+      node.left = build(order, first, mid, ids);
+      node.right = build(order, mid, last, ids);
+      for (const int child : {node.left, node.right}) {
+        const Node& c = nodes_[child];
+        if (!closed_) break;
+        edges.insert(edges.end(), edges_.begin() + c.edge_first,
+                     edges_.begin() + c.edge_first + c.edge_count);
+      }
     } else {
       node.first = first;
       node.count = last - first;
+      for (int i = first; i < last; ++i)
+        for (int k = 0; k < 3; ++k) edges.emplace_back(3 * order[i] + k, 3 * order[i] + (k + 1) % 3);
+    }
+    if (closed_) {
+      edges = boundary(edges, ids);
+      node.edge_first = static_cast<int>(edges_.size());
+      node.edge_count = static_cast<int>(edges.size());
+      edges_.insert(edges_.end(), edges.begin(), edges.end());
+    } else {
+      node.edge_count = std::numeric_limits<int>::max();
     }
     nodes_.push_back(node);
     return static_cast<int>(nodes_.size()) - 1;
@@ -146,8 +228,10 @@ class PartSolid {
 
   std::vector<Vector3d> tri_;
   bool closed_;
+  double eps_;
   std::vector<Node> nodes_;
   std::vector<int> order_;
+  std::vector<std::pair<int, int>> edges_;
   int root_ = 0;
 };
 
@@ -425,21 +509,91 @@ std::optional<std::pair<Cell, Cell>> split_cell(const Cell& cell, const PartSoli
                         child_cell(cell, std::move(minus), best->flipped(), solid, eps));
 }
 
-// Every edge shared by an even number of triangles (vertices matched exactly).
-bool is_closed(const std::vector<Vector3d>& triangles) {
-  std::map<std::tuple<double, double, double>, int> ids;
-  auto id = [&](const Vector3d& p) {
-    return ids.emplace(std::make_tuple(p.x(), p.y(), p.z()), static_cast<int>(ids.size())).first->second;
+// The share of the bounding box's diagonal within which vertices are welded into one.
+constexpr double kWeld = 1e-6;
+
+struct CellHash {
+  size_t operator()(const std::array<std::int64_t, 3>& c) const {
+    std::uint64_t h = 0;
+    for (const auto v : c) h = detail::splitmix(h ^ static_cast<std::uint64_t>(v));
+    return static_cast<size_t>(h);
+  }
+};
+
+// Moves every vertex within `radius` of a vertex kept before it onto the nearest such vertex (the
+// first kept of equally near ones); the others are kept. Returns each vertex's number among the
+// kept ones: equal numbers, equal positions.
+std::vector<int> weld(std::vector<Vector3d>& points, double radius) {
+  std::unordered_map<std::array<std::int64_t, 3>, std::vector<int>, CellHash> grid;  // kept per cell
+  std::vector<Vector3d> kept;
+  std::vector<int> ids(points.size());
+  auto cell_of = [radius](const Vector3d& p) {
+    std::array<std::int64_t, 3> c{};
+    for (int k = 0; k < 3; ++k)
+      c[k] = static_cast<std::int64_t>(std::clamp(std::floor(p[k] / radius), -4e18, 4e18));
+    return c;
   };
+  for (size_t i = 0; i < points.size(); ++i) {
+    const auto c = cell_of(points[i]);
+    int best = -1;
+    double nearest = radius;
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          const auto it = grid.find({c[0] + dx, c[1] + dy, c[2] + dz});
+          if (it == grid.end()) continue;
+          for (const int k : it->second) {
+            const double d = (kept[k] - points[i]).norm();
+            if (d < nearest || (d == nearest && best >= 0 && k < best) || (d <= nearest && best < 0))
+              std::tie(nearest, best) = std::make_pair(d, k);
+          }
+        }
+    if (best < 0) {
+      best = static_cast<int>(kept.size());
+      kept.push_back(points[i]);
+      grid[c].push_back(best);
+    }
+    ids[i] = best;
+    points[i] = kept[best];
+  }
+  return ids;
+}
+
+// Every edge (by welded vertex) shared by an even number of triangles.
+bool is_closed(const std::vector<int>& ids) {
   std::unordered_map<std::uint64_t, int> uses;
-  for (size_t t = 0; t < triangles.size(); t += 3)
+  for (size_t t = 0; t < ids.size(); t += 3)
     for (int k = 0; k < 3; ++k) {
-      const std::uint64_t a = id(triangles[t + k]), b = id(triangles[t + (k + 1) % 3]);
+      const std::uint64_t a = static_cast<std::uint32_t>(ids[t + k]);
+      const std::uint64_t b = static_cast<std::uint32_t>(ids[t + (k + 1) % 3]);
       if (a != b) ++uses[std::min(a, b) << 32 | std::max(a, b)];
     }
   for (const auto& [edge, count] : uses)
     if (count % 2) return false;
   return true;
+}
+
+// The mesh welded (kWeld of its box's diagonal), whether it is closed, and, when closed, its
+// triangles turned to outward normals (for split_face). Sets `size`, the box's diagonal [m].
+std::vector<Vector3d> prepare_mesh(std::vector<Vector3d> mesh, std::vector<int>& ids, bool& closed,
+                                   double& size) {
+  Vector3d lo = mesh.front(), hi = lo;
+  for (const auto& p : mesh) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  size = (hi - lo).norm();
+  if (!(size > 0)) throw InputError("the mesh has no extent: every vertex is at the same point");
+  ids = weld(mesh, kWeld * size);
+  closed = is_closed(ids);
+  double signed_volume = 0;
+  for (size_t t = 0; t < mesh.size(); t += 3) signed_volume += mesh[t].dot(mesh[t + 1].cross(mesh[t + 2]));
+  if (closed && signed_volume < 0)  // inward normals: turned outward
+    for (size_t t = 0; t < mesh.size(); t += 3) {
+      std::swap(mesh[t + 1], mesh[t + 2]);
+      std::swap(ids[t + 1], ids[t + 2]);
+    }
+  return mesh;
 }
 
 struct Piece {
@@ -537,22 +691,11 @@ ConvexSplit convex_split(const std::vector<Eigen::Vector3d>& triangles, const Co
                        " is not finite");
   ConvexSplit result;
   result.triangles = static_cast<int>(triangles.size() / 3);
-  result.closed = is_closed(triangles);
-  std::vector<Vector3d> oriented = triangles;
-  double signed_volume = 0;
-  for (size_t t = 0; t < oriented.size(); t += 3)
-    signed_volume += oriented[t].dot(oriented[t + 1].cross(oriented[t + 2]));
-  if (result.closed && signed_volume < 0)  // inward normals: turned outward for split_face
-    for (size_t t = 0; t < oriented.size(); t += 3) std::swap(oriented[t + 1], oriented[t + 2]);
-  Vector3d lo = oriented.front(), hi = lo;
-  for (const auto& p : oriented) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  const double size = (hi - lo).norm();
-  if (!(size > 0)) throw InputError("the mesh has no extent: every vertex is at the same point");
+  std::vector<int> ids;
+  double size = 0;
+  const std::vector<Vector3d> oriented = prepare_mesh(triangles, ids, result.closed, size);
   const double eps = 1e-9 * size;
-  const PartSolid solid(oriented, result.closed);
+  const PartSolid solid(oriented, ids, result.closed, eps);
   const double thickness = options.tolerance / 10;
   std::uint64_t measurements = 0;
   auto measure = [&](const std::vector<Vector3d>& points) {

@@ -32,8 +32,10 @@ struct ConvexSplit {
   std::vector<ConvexPiece> pieces;
   double worst_excess = 0;  //!< [m] the largest piece excess
   bool reached = true;      //!< every piece is within the tolerance
-  bool closed = true;       //!< every edge of the mesh is shared by an even number of triangles
-  int triangles = 0;        //!< the mesh's triangles
+  //! every edge of the mesh, vertices within 1e-6 of its box's diagonal welded, is shared by an even
+  //! number of triangles
+  bool closed = true;
+  int triangles = 0;  //!< the mesh's triangles
 };
 
 //! Splits the mesh `triangles` (three vertices per triangle, in metres) into convex pieces by

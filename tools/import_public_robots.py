@@ -204,6 +204,8 @@ ROBOTS = [
             "lift_m1_9": [0, -1.9, 0, 0, 0, 0],
             "fold_elbow_3_1": [0, -1.2, 3.1, 0, 0, 0],  # folded: the links really collide
         },
+        # The path `leeway bounds` runs in both modes (room, safety time): both ends pass in mesh mode.
+        "path": ("home", "lift_m1_2_elbow_1"),
     },
     {
         "name": "iiwa14",
@@ -219,6 +221,7 @@ ROBOTS = [
             "a6_p0_3": [0, 0, 0, 0, 0, 0.3, 0],
             "fold_a4_m2_a6_m2": [0, 0, 0, -2.0, 0, -2.0, 0],  # folded wrist: link_5 and link_7 meet
         },
+        "path": ("home", "a6_p0_3"),  # both ends pass in both modes
     },
 ]
 
@@ -268,8 +271,22 @@ def measure(robot, repos, leeway, work):
             failing = [line for line in report.splitlines() if line.startswith("problem: keyframe '%s'" % name)]
             poses[name] = "fails" if failing else "passes"
         results[mode] = {"import": " ".join(cmd), "excluded": excluded, "check_exit": code, "poses": poses,
-                         "check_output": report.strip().splitlines()}
+                         "check_output": report.strip().splitlines(), "bounds": bounds(leeway, cell, robot["path"], d)}
     return results
+
+
+def bounds(leeway, cell, path, folder):
+    """`leeway bounds` (the default, certified mode, one thread) along the robot's path: segments
+    proven, the mean kept share [%] and the safety stage's time [s], or the exit and the last line."""
+    out = os.path.join(folder, "bounds.json")
+    code, text = run([leeway, "bounds", cell, "--from", path[0], "--to", path[1], "--out", out, "--threads", "1"])
+    if code != 0:
+        return {"path": "-".join(path), "exit": code, "why": text.strip().splitlines()[-1]}
+    with open(out) as f:
+        b = json.load(f)
+    segments = b["safety"].get("segments", [])
+    return {"path": "-".join(path), "exit": 0, "proven": "%d/%d" % (sum(s["passed"] for s in segments), len(segments)),
+            "mean_share": 100 * b["room"]["mean_share"], "safety_s": b["timing_ms"]["safety"] / 1000}
 
 
 def main():
@@ -293,6 +310,12 @@ def main():
                 r["check_exit"], ", ".join("%s %s" % (k, v) for k, v in r["poses"].items())))
             for line in r["check_output"]:
                 print("    | " + line)
+            b = r["bounds"]
+            if b["exit"] == 0:
+                print("  bounds %s: %s segments proven, mean kept share %.1f %%, safety stage %.2f s (1 thread)" % (
+                    b["path"], b["proven"], b["mean_share"], b["safety_s"]))
+            else:
+                print("  bounds %s: exit %d: %s" % (b["path"], b["exit"], b["why"]))
 
 
 if __name__ == "__main__":

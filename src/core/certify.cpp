@@ -262,7 +262,8 @@ void Certifier::add_self_pairs() {
     sp.shared = shared_joints(links_[static_cast<size_t>(sp.link)], common);
     sp.other_geom = rp.geom1;
     sp.other_link = link_of[static_cast<size_t>(rp.geom1)];
-    sp.other_chain = sp.other_link;
+    sp.other_mesh = m.geom_type[rp.geom1] == mjGEOM_MESH;
+    if (sp.other_mesh) sp.other_hull = hull_extent(m, rp.geom1);
     if (sp.other_link >= 0) {
       const LinkChain& ol = links_[static_cast<size_t>(sp.other_link)];
       sp.other_shared = shared_joints(ol, common);
@@ -416,9 +417,8 @@ bool Certifier::leaf_free_impl(CertifyContext& ctx, const Eigen::VectorXd& lower
     const int li = self ? pair_info->link : pair / static_cast<int>(nobs);
     const int held = self ? pair_info->shared : 0;
     if (self) {
-      const LinkChain* chain =
-          pair_info->other_chain >= 0 ? &links_[static_cast<size_t>(pair_info->other_chain)] : nullptr;
-      other_at_c = geom_shape(m, d, pair_info->other_geom, chain && chain->mesh ? &chain->hull : nullptr);
+      other_at_c =
+          geom_shape(m, d, pair_info->other_geom, pair_info->other_mesh ? &pair_info->other_hull : nullptr);
       other = other_geom_swept(ctx, *pair_info, other_at_c);
     }
     const SweepObstacle& obs = self ? other : obstacles_[static_cast<size_t>(pair) % nobs];

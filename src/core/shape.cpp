@@ -16,7 +16,7 @@ Eigen::Vector3d vertex(const Shape& s, int k) {
 }
 
 // The support point in the geom frame along the local direction n.
-Eigen::Vector3d local_support(const Shape& s, const Eigen::Vector3d& n) {
+Eigen::Vector3d local_support(const Shape& s, const Eigen::Vector3d& n, int* hint) {
   const Eigen::Vector3d& z = s.size;
   auto sign = [](double v) { return v < 0 ? -1.0 : 1.0; };
   switch (s.type) {
@@ -41,8 +41,8 @@ Eigen::Vector3d local_support(const Shape& s, const Eigen::Vector3d& n) {
       return len > 0 ? Eigen::Vector3d(z.cwiseProduct(scaled) / len) : Eigen::Vector3d(z[0], 0, 0);
     }
     case mjGEOM_MESH: {
-      int best = 0;
-      double top = n.dot(vertex(s, 0));
+      int best = hint && *hint >= 0 && *hint < s.count ? *hint : 0;
+      double top = n.dot(vertex(s, best));
       if (s.edges) {  // climb the hull's edges: a linear function has no other local maximum on it
         for (int from = -1; from != best;) {
           from = best;
@@ -54,6 +54,7 @@ Eigen::Vector3d local_support(const Shape& s, const Eigen::Vector3d& n) {
             }
           }
         }
+        if (hint) *hint = best;
         return vertex(s, best);
       }
       for (int k = 1; k < s.count; ++k) {
@@ -259,7 +260,7 @@ struct Simplex {
 
 }  // namespace
 
-Eigen::Vector3d Shape::support_point(const Eigen::Vector3d& n) const {
+Eigen::Vector3d Shape::support_point(const Eigen::Vector3d& n, int* hint) const {
   if (type == mjGEOM_BOX || type == mjGEOM_HFIELD) {
     const Eigen::Vector3d local = box.rotation.transpose() * n;
     Eigen::Vector3d corner = box.half_size;
@@ -267,10 +268,10 @@ Eigen::Vector3d Shape::support_point(const Eigen::Vector3d& n) const {
       if (local[k] < 0) corner[k] = -corner[k];
     return box.center + box.rotation * corner;
   }
-  return origin + rotation * local_support(*this, rotation.transpose() * n);
+  return origin + rotation * local_support(*this, rotation.transpose() * n, hint);
 }
 
-double Shape::support(const Eigen::Vector3d& n) const {
+double Shape::support(const Eigen::Vector3d& n, int* hint) const {
   if (type == mjGEOM_PLANE) {
     const Eigen::Vector3d normal = rotation.col(2);
     const Eigen::Vector3d along = n.dot(normal) * normal;
@@ -280,7 +281,7 @@ double Shape::support(const Eigen::Vector3d& n) const {
   }
   if (type == mjGEOM_BOX || type == mjGEOM_HFIELD)
     return n.dot(box.center) + (box.rotation.transpose() * n).cwiseAbs().dot(box.half_size);
-  return n.dot(support_point(n));
+  return n.dot(support_point(n, hint));
 }
 
 Shape box_shape(const Box& box) {
@@ -303,15 +304,14 @@ Shape geom_shape(const mjModel& m, const mjData& d, int geom, const HullExtent* 
   switch (s.type) {
     case mjGEOM_MESH: {
       take_hull(m, geom, s);
-      const bool fixed = m.body_weldid[m.geom_bodyid[geom]] == 0;
-      if (extent && !fixed) {
+      if (extent) {  // the box in the geom frame
         s.box.center = s.origin + s.rotation * extent->centre;
         s.box.rotation = s.rotation;
         s.box.half_size = extent->half_size;
         s.radius = extent->radius;
         return s;
       }
-      s.box = mesh_box(s, fixed);
+      s.box = mesh_box(s, m.body_weldid[m.geom_bodyid[geom]] == 0);
       s.radius = 0;
       for (int k = 0; k < s.count; ++k)
         s.radius = std::max(s.radius, (s.origin + s.rotation * vertex(s, k) - s.box.center).norm());
@@ -367,9 +367,14 @@ HullExtent hull_extent(const mjModel& m, int geom) {
   return out;
 }
 
-ShapeDistance convex_distance(const Shape& a, const Shape& b, double tolerance) {
+ShapeDistance convex_distance(const Shape& a, const Shape& b, double tolerance, int* hint_a, int* hint_b) {
   ShapeDistance out;
-  auto support = [&](const Eigen::Vector3d& dir) { return a.support_point(dir) - b.support_point(-dir); };
+  int own_a = 0, own_b = 0;  // the iteration's directions converge: each support climbs from the last
+  if (!hint_a) hint_a = &own_a;
+  if (!hint_b) hint_b = &own_b;
+  auto support = [&](const Eigen::Vector3d& dir) {
+    return a.support_point(dir, hint_a) - b.support_point(-dir, hint_b);
+  };
   Simplex simplex;
   Eigen::Vector3d v = a.box.center - b.box.center;  // a point near the Minkowski difference a - b
   if (v.squaredNorm() == 0) v = Eigen::Vector3d::UnitX();

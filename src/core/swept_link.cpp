@@ -203,9 +203,9 @@ double SweptLink::box_extent(const Eigen::Vector3d& n) const {
   return (box_.rotation.transpose() * n).cwiseAbs().dot(box_.half_size);
 }
 
-double SweptLink::extent(const Eigen::Vector3d& n) const {
+double SweptLink::extent(const Eigen::Vector3d& n, int* hint) const {
   if (!shaped()) return box_extent(n);
-  return shape_.support(n) - n.dot(box_.center);
+  return shape_.support(n, hint) - n.dot(box_.center);
 }
 
 double SweptLink::remainder_cheap(const Eigen::Vector3d& n) const {
@@ -265,6 +265,7 @@ Separation separate(SweptLink& link, const SweepObstacle& obs, double margin) {
     return sep;
   };
   const bool boxes = obs.shape.is_box() && !link.shaped();
+  int hint_link[2] = {0, 0}, hint_obs[2] = {0, 0};  // mesh supports' climbing hints: toward, away
   const Eigen::Vector3d diff = obs.box.center - box.center;
   if (!obs.plane && diff.norm() - link.radius() - obs.radius > margin) {
     out.separated = true;
@@ -283,13 +284,18 @@ Separation separate(SweptLink& link, const SweepObstacle& obs, double margin) {
         return separated_on(nrm, std::abs(nrm.dot(diff)) - ro, link.box_extent(nrm));
       }
       const double p = nrm.dot(box.center);
-      const double ahead = -obs.shape.support(-nrm) - p, behind = p - obs.shape.support(nrm);
-      const double e_ahead = link.extent(nrm), e_behind = link.extent(-nrm);
+      const double ahead = -obs.shape.support(-nrm, &hint_obs[0]) - p,
+                   behind = p - obs.shape.support(nrm, &hint_obs[1]);
+      const double e_ahead = link.extent(nrm, &hint_link[0]), e_behind = link.extent(-nrm, &hint_link[1]);
       return ahead - e_ahead >= behind - e_behind ? separated_on(nrm, ahead, e_ahead)
                                                   : separated_on(-nrm, behind, e_behind);
     };
     bool sep = false;
-    if (!boxes) sep = try_axis(convex_distance(link.shape(), obs.shape, 1e-6).axis);
+    if (!boxes) {
+      // GJK ends at the two shapes' nearest vertices: the axes' supports toward each other climb
+      // from there, the supports away from each other from where the last such climb ended.
+      sep = try_axis(convex_distance(link.shape(), obs.shape, 1e-6, &hint_link[0], &hint_obs[0]).axis);
+    }
     for (int k = 0; k < 3 && !sep; ++k) sep = try_axis(obs.box.rotation.col(k));
     for (int k = 0; k < 3 && !sep; ++k) sep = try_axis(box.rotation.col(k));
     for (int k = 0; k < 3 && !sep; ++k)

@@ -185,7 +185,8 @@ class Certifier {
     int other_geom = -1;
     int other_link = -1;
     int other_shared = 0;
-    int other_chain = -1;  // the other geom's link (its hull extent), -1 for a robot base geom
+    bool other_mesh = false;  // the other geom is a mesh: its hull's extent, computed once
+    HullExtent other_hull;
   };
 
   void add_links(RobotState& state);

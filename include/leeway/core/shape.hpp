@@ -38,10 +38,12 @@ struct Shape {
   bool plane() const { return type == mjGEOM_PLANE; }
   //! True when the shape is exactly its box (box.hpp's box routines are then exact for it).
   bool is_box() const { return type == mjGEOM_BOX; }
-  //! The point of the shape farthest along n (n need not be unit; not for planes) [m].
-  Eigen::Vector3d support_point(const Eigen::Vector3d& n) const;
-  //! max over the shape's points x of n . x (for a plane: +infinity unless n is along -normal).
-  double support(const Eigen::Vector3d& n) const;
+  //! The point of the shape farthest along n (n need not be unit; not for planes) [m]. For a mesh,
+  //! `hint` (optional) is the hull vertex to climb from, and is set to the one it ends at: a caller
+  //! asking in nearby directions one after the other starts near the answer.
+  Eigen::Vector3d support_point(const Eigen::Vector3d& n, int* hint = nullptr) const;
+  //! max over the shape's points x of n . x (for a plane: +infinity unless n is along the normal).
+  double support(const Eigen::Vector3d& n, int* hint = nullptr) const;
 };
 
 //! A box as a shape.
@@ -60,8 +62,8 @@ struct HullExtent {
 HullExtent hull_extent(const mjModel& m, int geom);
 
 //! The shape of a geom after kinematics (d.geom_xpos, d.geom_xmat), as MuJoCo's collision sees it.
-//! For a mesh on a moving body, `extent` (its hull_extent, when given) saves the pass over the
-//! hull's vertices that its box and radius need.
+//! For a mesh, `extent` (its hull_extent, when given) saves the pass over the hull's vertices that
+//! its box and radius need; the box is then the one in the geom's frame.
 Shape geom_shape(const mjModel& m, const mjData& d, int geom, const HullExtent* extent = nullptr);
 
 //! The result of convex_distance.
@@ -79,7 +81,9 @@ struct ShapeDistance {
 //! support functions, until the bounds agree within `tolerance` [m] (or 64 iterations). The lower
 //! bound is a proof whatever the iteration count: every point of b lies beyond the plane through
 //! a's support point normal to `axis`, `lower` further on.
-ShapeDistance convex_distance(const Shape& a, const Shape& b, double tolerance = 1e-9);
+//! `hint_a`, `hint_b` (optional): the mesh supports' climbing hints (Shape::support_point).
+ShapeDistance convex_distance(const Shape& a, const Shape& b, double tolerance = 1e-9, int* hint_a = nullptr,
+                              int* hint_b = nullptr);
 
 //! Euclidean distance of two geom shapes [m], a lower bound (exact for two boxes and, within 1e-9 m,
 //! for others): box.hpp's box_distance for two boxes, the signed gap above a plane (0 when a point

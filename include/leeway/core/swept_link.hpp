@@ -79,7 +79,8 @@ class SweptLink {
   bool shaped() const { return !shape_.is_box(); }
   //! How far the link's shape at the centre reaches along the unit axis n beyond its box's centre,
   //! max over its points y of n . (y - box().center) [m]: box_extent(n) for a box.
-  double extent(const Eigen::Vector3d& n) const;
+  //! `hint`: the mesh support's climbing hint (Shape::support_point).
+  double extent(const Eigen::Vector3d& n, int* hint = nullptr) const;
   //! Radius of a sphere about the box's centre that holds the swept link (no Jacobian) [m].
   double cheap_radius() const { return iso_cheap_; }
   //! Builds the Jacobian-based bound (once per start()).

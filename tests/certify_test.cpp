@@ -398,8 +398,7 @@ class CertifyPropertyTest : public test::MujocoTestOf<::testing::TestWithParam<c
     // shapes at the test cells' count.
     const bool small = cell_ == "one_link" || cell_ == "hammer" || cell_ == "folding_hand";
     const bool real_geometry = cell_ == "round_pillars" || cell_ == "cad_cell";
-    return property_count(small ? 1500 : real_geometry ? 100 : 400) /
-           divisor;
+    return property_count(small ? 1500 : real_geometry ? 100 : 400) / divisor;
   }
   std::string trace() const { return "LEEWAY_CERTIFY_SEED=" + std::to_string(seed_) + ", cell " + cell_; }
   std::string cell_;
@@ -645,7 +644,8 @@ TEST_P(CertifyPropertyTest, WideWristRegionsCertifiedWithPivotBoxesAreFree) {
 
 INSTANTIATE_TEST_SUITE_P(CertifyCells, CertifyPropertyTest,
                          ::testing::Values("dallara", "baltico", "dlr", "rail_hall", "wide_elbow", "one_link",
-                                           "hammer", "telescope", "folding_hand", "round_arm", "round_pillars", "cad_cell"));
+                                           "hammer", "telescope", "folding_hand", "round_arm",
+                                           "round_pillars", "cad_cell"));
 
 class CertifyTest : public test::MujocoTest {};
 

@@ -264,7 +264,11 @@ Separation separate(SweptLink& link, const SweepObstacle& obs, double margin) {
     }
     return sep;
   };
+  // Two boxes are tested on their 15 axes and the centre line. A round or mesh pair is tested the
+  // same way on the boxes that hold the two shapes first (cheap, and where they are apart so are
+  // the shapes), then on the shapes' supports, from the axis of their closest points on.
   const bool boxes = obs.shape.is_box() && !link.shaped();
+  bool on_boxes = true;
   int hint_link[2] = {0, 0}, hint_obs[2] = {0, 0};  // mesh supports' climbing hints: toward, away
   const Eigen::Vector3d diff = obs.box.center - box.center;
   if (!obs.plane && diff.norm() - link.radius() - obs.radius > margin) {
@@ -279,7 +283,7 @@ Separation separate(SweptLink& link, const SweepObstacle& obs, double margin) {
       const double len = candidate.norm();
       if (len < 1e-9) return false;
       const Eigen::Vector3d nrm = candidate / len;
-      if (boxes) {
+      if (on_boxes) {
         const double ro = (obs.box.rotation.transpose() * nrm).cwiseAbs().dot(obs.box.half_size);
         return separated_on(nrm, std::abs(nrm.dot(diff)) - ro, link.box_extent(nrm));
       }
@@ -290,17 +294,23 @@ Separation separate(SweptLink& link, const SweepObstacle& obs, double margin) {
       return ahead - e_ahead >= behind - e_behind ? separated_on(nrm, ahead, e_ahead)
                                                   : separated_on(-nrm, behind, e_behind);
     };
-    bool sep = false;
-    if (!boxes) {
+    auto standard_axes = [&] {
+      bool sep = false;
+      for (int k = 0; k < 3 && !sep; ++k) sep = try_axis(obs.box.rotation.col(k));
+      for (int k = 0; k < 3 && !sep; ++k) sep = try_axis(box.rotation.col(k));
+      for (int k = 0; k < 3 && !sep; ++k)
+        for (int l = 0; l < 3 && !sep; ++l)
+          sep = try_axis(box.rotation.col(k).cross(obs.box.rotation.col(l)));
+      return sep || try_axis(diff);
+    };
+    bool sep = standard_axes();
+    if (!sep && !boxes) {
+      on_boxes = false;
       // GJK ends at the two shapes' nearest vertices: the axes' supports toward each other climb
       // from there, the supports away from each other from where the last such climb ended.
-      sep = try_axis(convex_distance(link.shape(), obs.shape, 1e-6, &hint_link[0], &hint_obs[0]).axis);
+      sep = try_axis(convex_distance(link.shape(), obs.shape, 1e-6, &hint_link[0], &hint_obs[0]).axis) ||
+            standard_axes();
     }
-    for (int k = 0; k < 3 && !sep; ++k) sep = try_axis(obs.box.rotation.col(k));
-    for (int k = 0; k < 3 && !sep; ++k) sep = try_axis(box.rotation.col(k));
-    for (int k = 0; k < 3 && !sep; ++k)
-      for (int l = 0; l < 3 && !sep; ++l) sep = try_axis(box.rotation.col(k).cross(obs.box.rotation.col(l)));
-    if (!sep) sep = try_axis(diff);
     out.separated = sep;
   }
   out.gap = best_gap;

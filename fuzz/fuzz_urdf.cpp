@@ -81,11 +81,20 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     leeway::fuzz::require_names_file(e, path);
     return 0;
   }
-  // The fragment in a cell, as leeway new-cell writes one (new_cell.hpp).
+  // The fragments in a cell, as leeway new-cell writes one (new_cell.hpp): the robot in the world
+  // body, the excludes (and the mesh geoms' assets) at the top level, the mesh copies beside them.
   const fs::path dir = input().dir();
+  for (const leeway::UrdfMeshFile& mesh : robot.meshes) {
+    const fs::path file(mesh.file);
+    if (file.is_absolute() || mesh.file.find("..") != std::string::npos) return 0;  // stays in dir
+    fs::create_directories((dir / file).parent_path());
+    std::ofstream(dir / file, std::ios::binary) << mesh.bytes;
+  }
   std::ofstream(dir / "robot.xml") << robot.mjcf;
+  std::ofstream(dir / "robot_excludes.xml") << robot.excludes_mjcf;
   const std::string cell = (dir / "cell.xml").string();
   std::ofstream(cell) << "<mujoco>\n  <compiler angle=\"radian\" autolimits=\"true\"/>\n"
+                         "  <include file=\"robot_excludes.xml\"/>\n"
                          "  <worldbody>\n    <include file=\"robot.xml\"/>\n  </worldbody>\n</mujoco>\n";
   try {
     leeway::Scene::load(cell);

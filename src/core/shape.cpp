@@ -372,7 +372,7 @@ ShapeDistance convex_distance(const Shape& a, const Shape& b, double tolerance, 
   int own_a = 0, own_b = 0;  // the iteration's directions converge: each support climbs from the last
   if (!hint_a) hint_a = &own_a;
   if (!hint_b) hint_b = &own_b;
-  auto support = [&](const Eigen::Vector3d& dir) {
+  auto support = [&](const Eigen::Vector3d& dir) -> Eigen::Vector3d {  // a value: the terms are temporaries
     return a.support_point(dir, hint_a) - b.support_point(-dir, hint_b);
   };
   Simplex simplex;

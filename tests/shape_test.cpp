@@ -9,6 +9,7 @@
 
 #include "leeway/core/certify.hpp"
 #include "leeway/core/kinematics.hpp"
+#include "leeway/core/mujoco_util.hpp"
 #include "leeway/core/scene.hpp"
 #include "leeway/core/shape.hpp"
 #include "stl_util.hpp"
@@ -169,9 +170,7 @@ TEST(ShapeTest, MeshSupportClimbingTheHullEqualsThePassOverEveryVertex) {
   test::write_binary_stl((dir.path() / "lumpy.stl").string(), sphere);
   const std::string xml = R"(<mujoco><asset><mesh name="lumpy" file="lumpy.stl"/></asset>
   <worldbody><geom name="lumpy" type="mesh" mesh="lumpy" pos="0.2 -0.1 0.3" euler="0.3 0.2 0.1"/></worldbody></mujoco>)";
-  char error[500] = "";
-  ModelPtr m(mj_loadXML(dir.write("cell.xml", xml).c_str(), nullptr, error, sizeof error));
-  ASSERT_TRUE(m) << error;
+  const ModelPtr m = load_model_file(dir.write("cell.xml", xml));  // throws with MuJoCo's message
   DataPtr d = make_data(*m);
   mj_kinematics(m.get(), d.get());
   const Shape climbing = geom_shape(*m, *d, 0);
@@ -200,9 +199,7 @@ TEST(ShapeTest, MeshGeomIsItsHullWhereMujocoPlacesIt) {
     <geom name="block" type="box" size="0.1 0.1 0.1" pos="2 2.1 3.05"/>
   </worldbody>
 </mujoco>)";
-  char error[500] = "";
-  ModelPtr m(mj_loadXML(dir.write("cell.xml", xml).c_str(), nullptr, error, sizeof error));
-  ASSERT_TRUE(m) << error;
+  const ModelPtr m = load_model_file(dir.write("cell.xml", xml));  // throws with MuJoCo's message
   DataPtr d = make_data(*m);
   mj_kinematics(m.get(), d.get());
   const Shape part = geom_shape(*m, *d, 0);
